@@ -1,0 +1,156 @@
+"""The typed, immutable program a script parses to.
+
+Spans are excluded from equality, so a program compares equal to the same
+program written with different spacing (``parse(fmt(x)) == parse(x)``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Literal
+
+from dial.errors import Span
+
+_NOSPAN = Span(0, 0, 0)
+
+
+@dataclass(frozen=True)
+class Word:
+    """One whitespace-separated word of a parameter."""
+
+    text: str
+    span: Span = field(default=_NOSPAN, compare=False)
+
+
+@dataclass(frozen=True)
+class Param:
+    """A parameter as written: a bare word, a quoted group, or ``key=value``.
+
+    A quoted group contributes each of its words in turn, as in the paper's
+    ``"0x0666_0x0222 400"``.
+    """
+
+    key: str | None
+    words: tuple[Word, ...]
+    quoted: bool
+    span: Span = field(default=_NOSPAN, compare=False)
+
+    def render(self) -> str:
+        body = " ".join(w.text for w in self.words)
+        if self.quoted:
+            body = f'"{body}"'
+        return f"{self.key}={body}" if self.key is not None else body
+
+
+@dataclass(frozen=True)
+class Definition:
+    """``% EVENT INSTRUCTION [PARAMS]``."""
+
+    event: str
+    instruction: str
+    params: tuple[Param, ...]
+    line: int = field(default=0, compare=False)
+    event_span: Span = field(default=_NOSPAN, compare=False)
+    instruction_span: Span = field(default=_NOSPAN, compare=False)
+    broken: bool = field(default=False, compare=False)  # its parameters did not tokenize
+
+
+@dataclass(frozen=True)
+class RunMark:
+    """One run drawn on an execution line, in block ticks (1-based, inclusive).
+
+    ``exec_end`` is the last ``#``/``=`` tick and ``hold_end`` the last tick
+    including ``-`` (equal to ``exec_end`` when there is no hold).
+    """
+
+    start: int
+    exec_end: int
+    hold_end: int
+    span: Span = field(default=_NOSPAN, compare=False)
+
+
+@dataclass(frozen=True)
+class ExecLine:
+    """An execution line: an event name and its diagram."""
+
+    event: str
+    runs: tuple[RunMark, ...]
+    last_tick: int  # rightmost non-space diagram tick, counting '.'
+    line: int = field(default=0, compare=False)
+    event_span: Span = field(default=_NOSPAN, compare=False)
+
+
+@dataclass(frozen=True)
+class Condition:
+    """``EVENT`` or ``!EVENT``: whether the latest run of EVENT ended ``done``."""
+
+    event: str
+    negated: bool
+    span: Span = field(default=_NOSPAN, compare=False)
+
+    def __str__(self) -> str:
+        return ("!" if self.negated else "") + self.event
+
+
+@dataclass(frozen=True)
+class Block:
+    """Consecutive execution lines sharing one tick axis."""
+
+    lines: tuple[ExecLine, ...]
+    length: int
+    line: int = field(default=0, compare=False)
+
+
+@dataclass(frozen=True)
+class Repeat:
+    """``@repeat N`` (kind ``count``) or ``@repeat until/while COND [max N]``."""
+
+    kind: Literal["count", "until", "while"]
+    count: int
+    condition: Condition | None
+    body: tuple[Statement, ...]
+    line: int = field(default=0, compare=False)
+    span: Span = field(default=_NOSPAN, compare=False)
+
+
+@dataclass(frozen=True)
+class If:
+    """``@if COND`` ... [``@else`` ...] ``@end``."""
+
+    condition: Condition
+    then: tuple[Statement, ...]
+    orelse: tuple[Statement, ...]
+    line: int = field(default=0, compare=False)
+
+
+@dataclass(frozen=True)
+class Call:
+    """``@call FILE.dial``; ``target`` is the path as written."""
+
+    target: str
+    line: int = field(default=0, compare=False)
+    span: Span = field(default=_NOSPAN, compare=False)
+
+
+Statement = Block | Repeat | If | Call
+
+
+@dataclass(frozen=True)
+class Setting:
+    """A top-level ``@scene`` or ``@tick`` value as written."""
+
+    text: str
+    line: int = field(default=0, compare=False)
+    span: Span = field(default=_NOSPAN, compare=False)
+
+
+@dataclass(frozen=True)
+class Program:
+    """A parsed script: its settings, definitions and execution part."""
+
+    path: str = field(compare=False)
+    scene: Setting | None
+    tick: float | None
+    tick_setting: Setting | None
+    definitions: tuple[Definition, ...]
+    body: tuple[Statement, ...]

@@ -1,0 +1,93 @@
+"""Bind a definition's written parameters to its instruction's schema."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from difflib import get_close_matches
+
+from dial.errors import Span
+from dial.instructions.catalogue import Instruction, ParamSpec
+from dial.instructions.types import ParamError
+from dial.parser.ast import Definition, Word
+
+
+@dataclass(frozen=True)
+class Bound:
+    """Bound arguments (SI values) and the span each came from."""
+
+    args: dict[str, object]
+    spans: dict[str, Span]
+
+
+def _parse(spec: ParamSpec, word: Word, errors: list[tuple[Span, str]]) -> object:
+    try:
+        return spec.type.parse(word.text)
+    except ParamError as e:
+        errors.append((word.span, f"bad {spec.name}: {e}"))
+        return None
+
+
+def bind(instr: Instruction, defn: Definition) -> tuple[Bound, list[tuple[Span, str]]]:
+    """Bind ``defn``'s parameters; return the arguments and any problems."""
+    errors: list[tuple[Span, str]] = []
+    args: dict[str, object] = {}
+    spans: dict[str, Span] = {}
+    usage = f"usage: {instr.usage}"
+    words = [w for p in defn.params if p.key is None for w in p.words]
+    specs: tuple[ParamSpec, ...]
+    if instr.verbs:
+        if not words:
+            errors.append((defn.instruction_span, f"{instr.name} needs a command; {usage}"))
+            return Bound(args, spans), errors
+        verb = _parse(instr.params[0], words[0], errors)
+        if verb is None:
+            return Bound(args, spans), errors
+        args["verb"], spans["verb"] = verb, words[0].span
+        specs, words = instr.verbs[str(verb)], words[1:]
+    else:
+        specs = tuple(p for p in instr.params if p.positional)
+    if len(words) > len(specs):
+        extra = words[len(specs)].span.to(words[-1].span)
+        errors.append((extra, f"too many parameters for {instr.name}; {usage}"))
+    elif instr.positional_counts and len(words) not in instr.positional_counts:
+        counts = " or ".join(str(n) for n in instr.positional_counts)
+        where = words[0].span.to(words[-1].span) if words else defn.instruction_span
+        errors.append((where, f"{instr.name} takes {counts} numbers, got {len(words)}; {usage}"))
+    for spec, word in zip(specs, words, strict=False):
+        args[spec.name], spans[spec.name] = _parse(spec, word, errors), word.span
+    for p in defn.params:
+        if p.key is None:
+            continue
+        spec = None if instr.verbs else instr.spec(p.key)
+        if spec is None:
+            names = [s.name for s in instr.params if not instr.verbs]
+            close = get_close_matches(p.key, names, n=1)
+            hint = f"; did you mean '{close[0]}'?" if close else ""
+            valid = f" (valid: {', '.join(names)})" if names else ""
+            errors.append((p.span, f"unknown parameter '{p.key}' for {instr.name}{hint}{valid}"))
+            continue
+        if p.key in spans:
+            errors.append((p.span, f"parameter '{p.key}' is given twice"))
+            continue
+        if len(p.words) != 1:
+            errors.append((p.span, f"'{p.key}' takes one value: expected {spec.type.expected}"))
+            continue
+        args[p.key], spans[p.key] = _parse(spec, p.words[0], errors), p.words[0].span
+    for spec in specs if instr.verbs else instr.params:
+        if spec.name in args:
+            continue
+        if spec.required:
+            how = spec.name if spec.positional or instr.verbs else f"{spec.name}="
+            errors.append(
+                (
+                    defn.instruction_span,
+                    f"{instr.name} is missing {how} ({spec.type.expected}); {usage}",
+                )
+            )
+        else:
+            args[spec.name] = spec.default
+    if not errors and instr.validate is not None:
+        message = instr.validate(args)
+        if message:
+            errors.append((defn.instruction_span, message))
+    return Bound(args, spans), errors

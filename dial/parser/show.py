@@ -1,0 +1,67 @@
+"""``dial show``: the compiled timeline as an aligned text chart of absolute ticks.
+
+A pure function from a checked script to text.
+"""
+
+from __future__ import annotations
+
+from dial.instructions.types import EFFECTORS
+from dial.parser.check import Script
+from dial.parser.timeline import Layout, Placed, expand
+
+
+def _ranges(ticks: range) -> str:
+    if not ticks:
+        return "-"
+    return str(ticks.start) if len(ticks) == 1 else f"{ticks.start}-{ticks[-1]}"
+
+
+def _lane(placed: list[Placed], length: int) -> str:
+    cells = [" "] * length
+    for p in placed:
+        cells[p.start - 1] = "#"
+        for t in range(p.start + 1, p.exec_end + 1):
+            cells[t - 1] = "="
+        for t in range(p.exec_end + 1, p.hold_end + 1):
+            cells[t - 1] = "-"
+    return "".join(cells).rstrip()
+
+
+def _ruler(length: int) -> str:
+    cells = [" "] * (length + 4)
+    for t in (1, *range(10, length + 1, 10)):
+        label = str(t)
+        cells[t - 1 : t - 1 + len(label)] = label
+    return "".join(cells).rstrip()
+
+
+def render(script: Script, layout: Layout | None = None) -> str:
+    """The chart (one lane per event), the sections, and every run with its ticks."""
+    layout = layout or expand(script)
+    names: list[str] = []
+    for p in layout.runs:
+        if p.run.event not in names:
+            names.append(p.run.event)
+    width = max([len(n) for n in names] + [len("tick")]) + 2
+    tick = f"tick {script.tick:g} s" if script.tick is not None else "default tick"
+    scene = script.program.scene.text if script.program.scene else "none"
+    out = [f"{script.path}: scene {scene}, {tick}, {layout.length} ticks", ""]
+    out.append("tick".ljust(width) + _ruler(layout.length))
+    for name in names:
+        lane = _lane([p for p in layout.runs if p.run.event == name], layout.length)
+        out.append(name.ljust(width) + lane)
+    out += ["", "sections:"]
+    span_w = max([len(f"{s.first}-{s.last}") for s in layout.sections] + [5])
+    for s in layout.sections:
+        out.append(f"  {f'{s.first}-{s.last}':<{span_w}}  {s.label}  ({s.path}:{s.line})")
+    out += ["", "runs:"]
+    ev_w = max([len(n) for n in names] + [5])
+    for p in layout.runs:
+        ex = range(p.start, p.exec_end + 1)
+        held = range(p.exec_end + 1, p.hold_end + 1)
+        effectors = " ".join(e for e in EFFECTORS if e in p.run.effectors) or "(sensing)"
+        out.append(
+            f"  {p.run.event:<{ev_w}}  {_ranges(range(p.start, p.hold_end + 1)):>7}"
+            f"  exec {_ranges(ex):<7}  held {_ranges(held):<7}  {effectors}"
+        )
+    return "\n".join(out) + "\n"
