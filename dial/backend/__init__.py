@@ -1,0 +1,1 @@
+"""MuJoCo backend: the robot model and its named indices."""

@@ -1,0 +1,244 @@
+"""World files: bundled scenes, the format, and error messages that name file and key."""
+
+from __future__ import annotations
+
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from dial.instructions.scene_names import SceneNotFoundError
+from dial.scene import (
+    Appro,
+    Depart,
+    Drive,
+    Move,
+    PlaneFit,
+    WorldFileError,
+    bundled_scene_names,
+    load_scene_names,
+    load_world,
+    models_dir,
+    resolve_scene,
+    worlds_dir,
+)
+
+from .conftest import write
+
+SCENES = (
+    "containment",
+    "containment_cylinder",
+    "containment_rounded",
+    "lightbulb",
+    "pour",
+    "surface",
+)
+PAPER_PROGRAMS = {
+    "lightbulb": {"to_bulb", "twist_wrist", "twist_CW", "retract_arm"},
+    "pour": {"get_top", "lift_top", "to_grasp", "pour", "retract_arm"},
+}
+PAPER_POSES = {"open_hand", "prelight", "unscrew", "ungrasp", "point", "prepit"}
+
+
+def test_models_dir_is_the_checkout_models_folder() -> None:
+    assert (models_dir() / "utah_hand_puma" / "objects_pour.xml").is_file()
+    assert bundled_scene_names() == SCENES
+
+
+@pytest.mark.parametrize("name", SCENES)
+def test_bundled_worlds_load(name: str) -> None:
+    world = load_world(resolve_scene(name, Path("/nonexistent")))
+    assert world.name == name and world.model_path.is_file()
+    assert set(world.poses) >= PAPER_POSES
+    assert set(world.programs) >= PAPER_PROGRAMS.get(name, set())
+    assert world.criteria
+
+
+def test_load_scene_names_reports_masks_locations_programs() -> None:
+    names = load_scene_names("lightbulb", Path.cwd())
+    assert names.name == "lightbulb"
+    assert names.poses["prelight"] == 0xFFFF
+    assert names.poses["unscrew"] == 0x1111  # abduction only: the grip is kept
+    assert names.poses["ungrasp"] == 0xEEEE
+    assert names.poses["point_down"] == 0x000F
+    assert "above_bulb" in names.locations
+    assert names.programs == PAPER_PROGRAMS["lightbulb"]
+
+
+def test_scene_path_wins_over_bundled_name(tmp_path: Path) -> None:
+    (tmp_path / "pour").write_text("")  # a file named like a bundled scene
+    assert resolve_scene("pour", tmp_path) == tmp_path / "pour"
+    assert resolve_scene("pour", tmp_path / "elsewhere") == worlds_dir() / "pour.toml"
+
+
+def test_unknown_scene_lists_the_bundled_names(tmp_path: Path) -> None:
+    with pytest.raises(SceneNotFoundError, match="unknown scene 'kitchen'") as e:
+        load_scene_names("kitchen", tmp_path)
+    assert "containment, containment_cylinder, containment_rounded, lightbulb" in str(e.value)
+
+
+def test_containment_variants_change_only_the_target() -> None:
+    box = load_world(worlds_dir() / "containment.toml")
+    cyl = load_world(worlds_dir() / "containment_cylinder.toml")
+    assert box.locations["above_target"].body == "containment_box"
+    assert cyl.locations["above_target"].body == "containment_cylinder"
+    assert cyl.criteria[0].body == "containment_cylinder"  # type: ignore[attr-defined]
+    assert cyl.model_path == box.model_path and cyl.poses == box.poses
+
+
+def test_values_are_converted_to_si() -> None:
+    pour = load_world(worlds_dir() / "pour.toml")
+    assert pour.poses["prelight"].angles[1] == pytest.approx(math.radians(20))
+    grasp = pour.locations["pitcher_grasp"]
+    assert grasp.body == "pour_pitcher" and grasp.axes == "object"
+    assert grasp.rpy == pytest.approx((0, math.pi / 2, 0))
+    # Pitch 90 deg about y: w = x = cos 45 deg... as a quaternion (w, x, y, z).
+    assert grasp.quat == pytest.approx((math.sqrt(0.5), 0, math.sqrt(0.5), 0))
+    down = pour.locations["home"]
+    assert down.body is None and down.quat == pytest.approx((0, 1, 0, 0), abs=1e-12)
+    program = pour.programs["pour"].statements
+    assert program[0] == Move(1, "pitcher_lift", straight=True)
+    assert program[2] == Drive(3, 6, pytest.approx(-math.radians(120)))  # type: ignore[arg-type]
+    assert load_world(worlds_dir() / "pour.toml").programs["get_top"].statements == (
+        Appro(1, "lid_grasp", 0.10),
+        Move(2, "lid_grasp", straight=True),
+    )
+    surface = load_world(worlds_dir() / "surface.toml")
+    (plane,) = surface.criteria
+    assert isinstance(plane, PlaneFit)
+    assert plane.normal_tol == pytest.approx(math.radians(2)) and plane.extent_tol == 0.005
+    assert surface.programs["retract_arm"].statements == (Depart(1, 0.15),)
+
+
+# Errors ------------------------------------------------------------------------------------
+
+HEAD = """
+[scene]
+model = "{model}"
+poses = "{poses}"
+
+[objects]
+block = "surface_block"
+"""
+
+
+def _world(tmp_path: Path, body: str) -> Path:
+    head = HEAD.format(
+        model=(models_dir() / "utah_hand_puma" / "scene_surface.xml").as_posix(),
+        poses=(worlds_dir() / "hand_poses.toml").as_posix(),
+    )
+    return write(tmp_path / "w.toml", head + body)
+
+
+@pytest.mark.parametrize(
+    ("body", "message"),
+    [
+        (
+            "[locations]\na = { pos = [0, 0], rpy = [0, 0, 0] }",
+            "locations.a.pos: expected a list of 3",
+        ),
+        ("[locations]\na = { pos = [0, 0, 0] }", "locations.a: missing key 'rpy'"),
+        (
+            '[locations]\na = { object = "cup", pos = [0, 0, 0], rpy = [0, 0, 0] }',
+            "locations.a.object: unknown object 'cup'; valid: block",
+        ),
+        (
+            '[locations]\na = { pos = [0, 0, 0], rpy = [0, 0, 0], axes = "world" }',
+            "locations.a.axes: axes applies to object-relative locations only",
+        ),
+        (
+            '[locations]\na = { pos = [0, 0, "x"], rpy = [0, 0, 0] }',
+            "locations.a.pos[2]: expected a number, got a string ('x')",
+        ),
+        (
+            "[locations]\na = { pos = [0, 0, 0], rpy = [0, 0, 0] }\n"
+            '[programs]\np = """\nMOVE a\nMOVE b\n"""',
+            "programs.p line 2: unknown location 'b'; valid locations: a",
+        ),
+        (
+            '[programs]\np = "JUMP 3"',
+            "programs.p line 1: unknown command 'JUMP'; valid commands: MOVE",
+        ),
+        ('[programs]\np = "DRIVE 7 10"', "expected a PUMA joint number from 1 to 6, got '7'"),
+        ('[programs]\np = "DEPART 5"', "distance 5 is out of range: expected -1 m to 1 m"),
+        ('[programs]\np = "DEPART 3N"', "unit 'N' is not a length unit"),
+        ('[programs]\np = "; nothing"', "programs.p: a program needs at least one statement"),
+        ("[poses.open_hand]\nindex = [0, 0, 0, 0]", "poses.open_hand: pose is already defined"),
+        (
+            "[poses.p]\npinky = [0, 0, 0, 0]",
+            "poses.p.pinky: unknown key; valid keys: index, middle",
+        ),
+        ("[poses.p]\nindex = { knuckle = 3 }", "valid keys: abd, mcp, pip, dip"),
+        ("[poses.p]\nindex = [0, 0, 0, 200]", "poses.p.index.dip: 200 deg is beyond +-180"),
+        ("[poses.p]", "poses.p: a pose must set at least one joint"),
+        (
+            '[criteria.c]\nkind = "best"',
+            "criteria.c.kind: unknown criterion kind 'best'; valid: fraction",
+        ),
+        ('[criteria.c]\nkind = "plane_fit"\nset = "s"', "criteria.c: missing key 'object'"),
+        (
+            '[criteria.c]\nkind = "plane_fit"\nset = "s"\nobject = "block"\nface = "top"',
+            "criteria.c.face: unknown face 'top'; valid: +x, -x",
+        ),
+        (
+            '[criteria.c]\nkind = "fraction_in_region"\nbodies = "b*"\nregion = "r"\nmin = 2',
+            "criteria.c: min must be a fraction in (0, 1]",
+        ),
+        (
+            '[criteria.c]\nkind = "upright"\nobject = "block"\ntilt = 3',
+            "criteria.c.tilt: unknown key",
+        ),
+        ("[bogus]", "bogus: unknown key; valid keys: scene, objects, poses"),
+        ("[locations]\n1a = { pos = [0, 0, 0], rpy = [0, 0, 0] }", "locations.1a: invalid name"),
+    ],
+)
+def test_errors_name_file_key_and_choices(tmp_path: Path, body: str, message: str) -> None:
+    path = _world(tmp_path, body)
+    with pytest.raises(WorldFileError) as e:
+        load_world(path)
+    assert str(e.value).startswith(f"{path}: ")
+    assert message in str(e.value)
+    assert isinstance(e.value, ValueError)  # the SceneLoader contract
+
+
+def test_toml_syntax_error_names_the_file(tmp_path: Path) -> None:
+    path = write(tmp_path / "bad.toml", "[scene\n")
+    with pytest.raises(WorldFileError, match=r"bad.toml: invalid TOML: .*line 1"):
+        load_world(path)
+
+
+def test_missing_model_and_pose_file(tmp_path: Path) -> None:
+    path = write(tmp_path / "w.toml", '[scene]\nmodel = "nope.xml"\n[objects]\na = "b"\n')
+    with pytest.raises(WorldFileError, match=r"scene.model: no such model file: .*nope.xml"):
+        load_world(path)
+    path = _world(tmp_path, "").read_text().replace("hand_poses.toml", "gone.toml")
+    with pytest.raises(WorldFileError, match=r"w.toml: no such file: .*gone.toml"):
+        load_world(write(tmp_path / "w.toml", path))
+
+
+def test_extends_a_bundled_scene_by_name_and_detects_cycles(tmp_path: Path) -> None:
+    mine = write(
+        tmp_path / "mine.toml",
+        'extends = "containment"\n[objects]\ntarget = "containment_rounded"\n',
+    )
+    world = load_world(mine)
+    assert world.name == "mine" and world.locations["contain_target"].body == "containment_rounded"
+    assert load_scene_names("mine.toml", tmp_path).programs == {"to_object", "retract_arm"}
+    write(tmp_path / "a.toml", 'extends = "b.toml"\n')
+    write(tmp_path / "b.toml", 'extends = "a.toml"\n')
+    with pytest.raises(WorldFileError, match=r"extends cycle: .*a.toml -> .*b.toml -> .*a.toml"):
+        load_world(tmp_path / "a.toml")
+    write(tmp_path / "c.toml", 'extends = "nowhere"\n')
+    with pytest.raises(WorldFileError, match=r"c.toml: extends: unknown scene 'nowhere'"):
+        load_world(tmp_path / "c.toml")
+
+
+def test_parsing_does_not_import_mujoco() -> None:
+    code = (
+        "import sys, dial.scene; dial.scene.load_scene_names('pour', __import__('pathlib').Path())"
+    )
+    code += "; assert 'mujoco' not in sys.modules, 'dial.scene imported mujoco'"
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
