@@ -18,8 +18,8 @@ DEFINITIONS = """\
 % pre   hand_pose      "open_hand"
 % pt    hand_pose      "point" fingers=0x000F
 % grab  grasp_force    "0x0666_0x0222 4N" timeout=5s
-% down  guarded_move   finger=index 0 0 -20mm until=tactile:0.05N max=25mm
-% touch tactile_contact finger=index threshold=0.05N
+% down  guarded_move   finger=index 0 0 -20mm until=tactile:0.1mm max=25mm
+% touch tactile_contact finger=index threshold=0.1mm
 % rec   record_contact finger=index into=surface
 % fit   fit_plane      surface
 """

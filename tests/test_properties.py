@@ -15,7 +15,7 @@ DEFINITIONS = [
     '% open hand_pose "open_hand"',
     "% pt  hand_pose point fingers=0x000F",
     '% grab grasp_force "0x0666_0x0222 4N" timeout=2s',
-    "% touch tactile_contact finger=index threshold=0.05N  // wait for it",
+    "% touch tactile_contact finger=index threshold=0.1mm  // wait for it",
     "% down guarded_move finger=index 0 0 -2cm until=tactile,force:1N",
     "% rec record_contact finger=index into=s",
     "% fit fit_plane s",

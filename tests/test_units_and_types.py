@@ -66,8 +66,8 @@ def test_fingers_by_name_or_number() -> None:
 
 
 def test_contact_conditions_with_thresholds() -> None:
-    assert Conditions().parse("tactile:0.1N,position:2mm") == (
-        ("tactile", 0.1),
+    assert Conditions().parse("tactile:0.1mm,position:2mm") == (
+        ("tactile", pytest.approx(0.0001)),
         ("position", pytest.approx(0.002)),
     )
     assert Conditions().parse("force")[0][0] == "force"

@@ -34,7 +34,7 @@ Args = Mapping[str, object]
 EffectorFn = Callable[[Args, "SceneNames | None"], frozenset[str]]
 
 # Largest tension a tendon actuator can pull (N); grasp thresholds must stay below it.
-TENDON_TENSION_LIMIT = 40.0
+TENDON_TENSION_LIMIT = 50.0
 DEFAULT_TIMEOUT = 10.0
 REQUIRED = object()
 
@@ -231,7 +231,7 @@ INSTRUCTIONS: dict[str, Instruction] = {
         ),
         _contact("position_contact", ("length", "mm"), 0.003, "the fingertip position error"),
         _contact("force_contact", ("force", "N"), 0.5, "the change in tendon force differential"),
-        _contact("tactile_contact", ("force", "N"), 0.05, "the largest taxel reading"),
+        _contact("tactile_contact", ("length", "mm"), 0.0001, "the deepest taxel reading"),
         Instruction(
             "grasp_force",
             "indeterminate",

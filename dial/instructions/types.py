@@ -19,7 +19,7 @@ ALL_JOINTS = 0xFFFF
 CONTACT_KINDS: tuple[str, ...] = ("tactile", "force", "position")
 # Threshold dimension and default of each contact kind (SI).
 CONTACT_THRESHOLDS: dict[str, tuple[Dimension, str, float]] = {
-    "tactile": ("force", "N", 0.05),
+    "tactile": ("length", "mm", 0.0001),  # taxel penetration depth
     "force": ("force", "N", 0.5),
     "position": ("length", "mm", 0.003),
 }
@@ -168,7 +168,7 @@ class Name(ParamType):
 
 
 class Conditions(ParamType):
-    """``tactile[:0.05N],force[:1N],position[:3mm]``: contact conditions, any one ends the move."""
+    """``tactile[:0.2mm],force[:1N],position[:3mm]``: contact conditions, any one ends the move."""
 
     expected = "contact conditions KIND[:THRESHOLD],... with KIND tactile, force or position"
 

@@ -119,3 +119,11 @@ def test_differential_tracks_the_load_of_a_pressing_finger(
         assert loaded[-1, joint] > 1.0
     assert loaded[-1, 1] > 20.0
     assert abs(loaded[-1, 0]) < 0.5  # abduction sees almost none of it
+
+
+def test_catalogue_tension_limit_matches_the_model() -> None:
+    # grasp_force thresholds are range-checked at check time against the model's limit.
+    from dial.backend.model import RobotIndex, load_model
+    from dial.instructions.catalogue import TENDON_TENSION_LIMIT
+
+    assert RobotIndex.from_model(load_model()).tension_limit == TENDON_TENSION_LIMIT
