@@ -7,9 +7,11 @@ usage error, 130 an interrupt.
 from __future__ import annotations
 
 import argparse
+import json
 import sys
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
+from typing import Any
 
 from dial import __version__
 from dial.errors import DialError, ScriptError
@@ -19,6 +21,11 @@ from dial.parser.fmt import format_text
 from dial.parser.show import render
 from dial.parser.timeline import expand
 from dial.resources import resolve_script
+
+
+class UsageError(DialError):
+    """A command-line usage problem: exit status 2."""
+
 
 EPILOG = """\
 scripts resolve as a path if it exists, else as a bundled example by name
@@ -79,6 +86,89 @@ def cmd_fmt(args: argparse.Namespace) -> int:
     return status
 
 
+def _progress(quiet: bool) -> Callable[[int, float, list[str]], None] | None:
+    if quiet or not sys.stderr.isatty():
+        return None
+
+    def show(tick: int, sim_time: float, running: list[str]) -> None:
+        line = f"tick {tick:4d}  t={sim_time:7.2f} s  {', '.join(running) or '-'}"
+        sys.stderr.write("\r" + line[:100].ljust(100))
+        sys.stderr.flush()
+
+    return show
+
+
+def cmd_run(args: argparse.Namespace) -> int:
+    for flag in ("record", "video", "rerun", "viewer"):
+        if getattr(args, flag):
+            raise UsageError(f"--{flag} is reserved for the recording work and not available yet")
+    script = _load(args.script)
+    from dial.engine import RunOptions, run, tick_length
+
+    log_file = open(args.log, "w", encoding="utf-8") if args.log else None  # noqa: SIM115
+    options = RunOptions(
+        tick=args.tick,
+        speed=args.speed,
+        seed=args.seed,
+        perturb_mm=args.perturb,
+        realtime=args.realtime,
+        log=log_file,
+        on_tick=_progress(args.quiet),
+    )
+    tick = tick_length(script, options)
+    try:
+        result = run(script, options)
+    except KeyboardInterrupt:
+        if log_file is not None:
+            log_file.write(json.dumps({"kind": "interrupted"}) + "\n")
+            log_file.close()
+        print("dial: interrupted; every effector holds its pose", file=sys.stderr)
+        return 130
+    summary = {
+        "ok": result.ok,
+        "success": result.success,
+        "sim_time": round(result.summary.sim_time, 6),
+        "wall_time": round(result.wall_time, 3),
+        "physics_steps": result.physics_steps,
+        "ticks": result.summary.ticks,
+        "tick": tick,
+        "outcomes": result.summary.outcomes,
+        "criteria": result.details,
+        "results": result.results,
+        "error": str(result.summary.error) if result.summary.error else None,
+    }
+    if log_file is not None:
+        result.log.write("summary", **summary)
+        log_file.close()
+    if not args.quiet and sys.stderr.isatty():
+        sys.stderr.write("\r" + " " * 100 + "\r")
+    if not args.quiet:
+        _print_summary(result, tick)
+    if result.summary.error is not None:
+        print(f"dial: {result.summary.error}", file=sys.stderr)
+    if args.json:
+        print(json.dumps(summary, default=float))
+    return 0 if result.ok else 1
+
+
+def _print_summary(result: Any, tick: float) -> None:
+    s = result.summary
+    rtf = s.sim_time / result.wall_time if result.wall_time > 0 else float("inf")
+    print(f"scene {result.world.name}: {s.ticks} ticks of {tick:g} s")
+    ends = result.log.of("end")
+    width = max([len(r["event"]) for r in ends] + [5])
+    for r in ends:
+        note = f"  {r['message']}" if r.get("message") else ""
+        print(f"  tick {r['tick']:4d}  {r['event']:<{width}}  {r['outcome']}{note}")
+    print(
+        f"simulated {s.sim_time:.2f} s in {result.wall_time:.2f} s wall "
+        f"(real-time factor {rtf:.1f}), {result.physics_steps} physics steps"
+    )
+    for name, ok in result.success.items():
+        print(f"  [{'x' if ok else ' '}] {name}: {result.details[name]}")
+    print("OK" if result.ok else "FAILED")
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="dial",
@@ -89,6 +179,38 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--version", action="version", version=f"dial {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+
+    p = sub.add_parser(
+        "run",
+        help="run a script in its scene and report the success criteria",
+        description="Run a script on the simulated hand and arm. Shows live progress, then "
+        "each event's outcome, the simulated and wall time and the scene's success criteria. "
+        "Exit 0 when the run completes and every criterion holds, 1 on a script or run "
+        "error or a failed criterion, 130 on interrupt.",
+    )
+    p.add_argument("script", metavar="SCRIPT", help="script path or bundled name")
+    p.add_argument("--tick", type=float, metavar="S", help="tick length in s (default: @tick)")
+    p.add_argument("--speed", type=float, default=1.0, metavar="F", help="divide the tick by F")
+    p.add_argument("--seed", type=int, default=0, metavar="N", help="seed for --perturb")
+    p.add_argument(
+        "--perturb",
+        type=float,
+        default=0.0,
+        metavar="MM",
+        help="displace the true object poses by MM from the believed ones (seeded direction)",
+    )
+    p.add_argument("--log", metavar="FILE.jsonl", help="write the event log as JSON Lines")
+    p.add_argument("--json", action="store_true", help="print a JSON summary as the last line")
+    p.add_argument("--quiet", action="store_true", help="no progress and no summary table")
+    p.add_argument("--realtime", action="store_true", help="pace the run to wall-clock time")
+    for flag, what in (
+        ("--record", "FILE.rrd"),
+        ("--video", "FILE.mp4"),
+    ):
+        p.add_argument(flag, metavar=what, help="reserved: comes with the recording work")
+    p.add_argument("--rerun", action="store_true", help="reserved: comes with the recording work")
+    p.add_argument("--viewer", action="store_true", help="reserved: comes with the recording work")
+    p.set_defaults(func=cmd_run)
 
     p = sub.add_parser(
         "check",
@@ -131,6 +253,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     except ScriptError as e:
         print(e.render(), file=sys.stderr)
         return 1
+    except UsageError as e:
+        print(f"dial: {e}", file=sys.stderr)
+        return 2
     except DialError as e:
         print(f"dial: {e}", file=sys.stderr)
         return 1

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import math
 from collections import defaultdict
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -86,6 +87,7 @@ class Runner:
         tick: float,
         log: EventLog | None = None,
         abort_on: frozenset[Outcome] = ABORT_ON,
+        on_tick: Callable[[int, float, list[str]], None] | None = None,
     ) -> None:
         self.robot = robot
         self.factory = factory
@@ -93,6 +95,7 @@ class Runner:
         self.n = periods_per_tick(tick, self.period)
         self.log = log or EventLog()
         self.abort_on = abort_on
+        self.on_tick = on_tick  # progress display: (tick, sim time, running events)
         self.periods = 0  # simulated control periods so far
         self.clock = 0  # tick time, in periods: stands still while a tick is stretched
         self.tick = 0  # absolute ticks started so far
@@ -215,6 +218,8 @@ class Runner:
                 stretch += 1
                 await self._period(stretched=True)
             mine = [a for a in mine if a.ended is None]
+            if self.on_tick is not None:
+                self.on_tick(self.tick, self.sim_time, [a.info.event.name for a in self.active])
             self.log.write(
                 "tick", tick=self.tick, block_tick=k, t0=t0, t1=self.sim_time, stretch=stretch
             )

@@ -1,0 +1,264 @@
+"""The MuJoCo driver: the single owner of the physics.
+
+Each control period the runner hands primitives a :class:`Snapshot`; they write
+set-points into their own effectors' command slots (:class:`Slots`). The driver
+then applies the slots and steps the physics. Guards armed by guarded moves are
+checked after every physics step, so a contact freezes its effector at the step
+where it is first sensed. Engine-owned safety monitors run every period.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+import trio
+
+from dial.backend.model import HAND_JOINTS, RobotIndex, hand_ctrl
+from dial.backend.snapshot import FloatArray, Snapshot, Trip, frozen
+from dial.errors import DialError
+from dial.instructions.types import FINGERS
+from dial.scene.thread import Thread, find_threads
+from dial.scheduler.log import EventLog
+
+CONTROL_PERIOD = 0.01  # s; physics runs at the model's timestep (0.002 s)
+SATURATION_LIMIT_S = 1.0  # a tendon pinned at its tension limit this long is a fault
+POSITION_LEVER = 0.1  # m: joint error (rad) to fingertip displacement, about a finger length
+
+
+class EffectorError(DialError):
+    """A primitive wrote to an effector its run does not own (a bug, not a script error)."""
+
+
+@dataclass
+class Guard:
+    """Stop ``effector`` when any condition holds on any of the ``sense`` fingers."""
+
+    effector: str  # "arm" or a finger name
+    conditions: tuple[tuple[str, float], ...]
+    sense: tuple[int, ...]
+    baseline: FloatArray  # (16,) differentials when armed, for force conditions
+    trip: Trip | None = None
+
+
+class MujocoRobot:
+    """The robot protocol of :mod:`dial.scheduler` on a MuJoCo model."""
+
+    def __init__(
+        self,
+        model: mujoco.MjModel,
+        data: mujoco.MjData,
+        log: EventLog | None = None,
+        period: float = CONTROL_PERIOD,
+    ) -> None:
+        self.model, self.data = model, data
+        self.index = RobotIndex.from_model(model)
+        self.log = log or EventLog()
+        self.substeps = max(1, round(period / model.opt.timestep))
+        self._period = self.substeps * model.opt.timestep
+        self.steps = 0
+        ix = self.index
+        self.arm_target = data.qpos[ix.arm_qpos].copy()
+        self.hand_target = data.qpos[ix.hand_qpos].copy()
+        self.limp = np.zeros(16, dtype=bool)
+        self.threads: tuple[Thread, ...] = find_threads(model)
+        self.guards: dict[int, Guard] = {}
+        self._next_guard = 0
+        self._trips: dict[int, Trip] = {}
+        self._saturated_since = np.full(32, -1.0)
+        self._tactile_adr = [int(a) for a in ix.tactile_sensors]
+        self._arm_range = model.jnt_range[model.actuator_trnid[ix.arm_actuators, 0]]
+        hand_joints = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, n) for n in HAND_JOINTS]
+        self.hand_range = model.jnt_range[hand_joints].copy()  # (16, 2) rad, mask order
+        self.pace: float | None = None  # wall seconds per simulated second, for --realtime
+
+    # -- the scheduler's robot protocol ---------------------------------------------------------
+    @property
+    def period(self) -> float:
+        return self._period
+
+    def snapshot(self) -> Snapshot:
+        d, ix = self.data, self.index
+        tensions = d.sensordata[ix.tension_sensors]
+        return Snapshot(
+            time=self.steps * self.model.opt.timestep,
+            step=self.steps,
+            arm_q=frozen(d.qpos[ix.arm_qpos]),
+            arm_target=frozen(self.arm_target),
+            hand_q=frozen(d.qpos[ix.hand_qpos]),
+            hand_target=frozen(self.hand_target),
+            tensions=frozen(tensions),
+            differentials=frozen(tensions[0::2] - tensions[1::2]),
+            tactile=frozen(self.tactile()),
+            tool_pos=frozen(d.site_xpos[ix.tool_site]),
+            tool_rot=frozen(d.site_xmat[ix.tool_site].reshape(3, 3)),
+            tips=frozen(d.site_xpos[ix.fingertip_sites]),
+            trips=dict(self._trips),
+        )
+
+    async def advance(self) -> str | None:
+        self._apply()
+        m, d = self.model, self.data
+        if not self.guards and not self.threads:
+            mujoco.mj_step(m, d, nstep=self.substeps)
+            self.steps += self.substeps
+        else:
+            for _ in range(self.substeps):
+                mujoco.mj_step(m, d)
+                self.steps += 1
+                for thread in self.threads:
+                    if thread.update(d):
+                        self.log.write("thread", name=thread.name, t=self.time, step=self.steps)
+                if self.guards:
+                    self._check_guards()
+        fault = self._monitor()
+        if self.pace is not None:
+            await trio.sleep(self._period * self.pace)
+        else:
+            await trio.lowlevel.checkpoint()
+        return fault
+
+    def hold_all(self) -> None:
+        ix = self.index
+        self.arm_target = self.data.qpos[ix.arm_qpos].copy()
+        self.hand_target = self.data.qpos[ix.hand_qpos].copy()
+        self.limp[:] = False
+        self.guards.clear()
+        self._apply()
+
+    # -- commands ----------------------------------------------------------------------------------
+    @property
+    def time(self) -> float:
+        return self.steps * self.model.opt.timestep
+
+    def tactile(self) -> FloatArray:
+        """(4, 16, 16) taxel depths (m)."""
+        sd = self.data.sensordata
+        return np.stack([sd[a : a + 256] for a in self._tactile_adr]).reshape(4, 16, 16)
+
+    def _apply(self) -> None:
+        ix, d = self.index, self.data
+        d.ctrl[ix.arm_actuators] = self.arm_target
+        target = np.where(self.limp, d.qpos[ix.hand_qpos], self.hand_target)
+        d.ctrl[ix.tendon_actuators] = hand_ctrl(target)
+
+    # -- guards -----------------------------------------------------------------------------------
+    def arm_guard(
+        self, effector: str, conditions: Iterable[tuple[str, float]], sense: Iterable[int]
+    ) -> int:
+        """Arm a guard; it is checked after every physics step until disarmed."""
+        tensions = self.data.sensordata[self.index.tension_sensors]
+        guard = Guard(effector, tuple(conditions), tuple(sense), tensions[0::2] - tensions[1::2])
+        self._next_guard += 1
+        self.guards[self._next_guard] = guard
+        return self._next_guard
+
+    def disarm(self, guard_id: int) -> None:
+        self.guards.pop(guard_id, None)
+        self._trips.pop(guard_id, None)
+
+    def _check_guards(self) -> None:
+        d, ix = self.data, self.index
+        tensions = None
+        for gid, guard in list(self.guards.items()):
+            for kind, threshold in guard.conditions:
+                for f in guard.sense:
+                    if kind == "tactile":
+                        a = self._tactile_adr[f]
+                        value = float(d.sensordata[a : a + 256].max())
+                    elif kind == "force":
+                        if tensions is None:
+                            tensions = d.sensordata[ix.tension_sensors]
+                        diff = tensions[0::2] - tensions[1::2]
+                        value = float(np.abs(diff - guard.baseline)[4 * f : 4 * f + 4].max())
+                    else:
+                        err = (
+                            self.hand_target[4 * f : 4 * f + 4]
+                            - d.qpos[ix.hand_qpos[4 * f : 4 * f + 4]]
+                        )
+                        value = float(np.linalg.norm(err)) * POSITION_LEVER
+                    if value >= threshold:
+                        self._trip(gid, guard, Trip(self.time, self.steps, kind, f, value))
+                        break
+                if guard.trip is not None:
+                    break
+
+    def _trip(self, gid: int, guard: Guard, trip: Trip) -> None:
+        guard.trip = trip
+        self._trips[gid] = trip
+        del self.guards[gid]
+        ix, d = self.index, self.data
+        # Freeze the guarded effector where it is, at this physics step.
+        if guard.effector == "arm":
+            self.arm_target = d.qpos[ix.arm_qpos].copy()
+        else:
+            f = FINGERS.index(guard.effector)
+            self.hand_target[4 * f : 4 * f + 4] = d.qpos[ix.hand_qpos[4 * f : 4 * f + 4]]
+        self._apply()
+        self.log.write(
+            "contact",
+            effector=guard.effector,
+            kind=trip.kind,
+            finger=FINGERS[trip.finger],
+            value=trip.value,
+            t=trip.time,
+            step=trip.step,
+        )
+
+    # -- safety monitors --------------------------------------------------------------------------
+    def _monitor(self) -> str | None:
+        d, ix = self.data, self.index
+        if not (np.isfinite(d.qpos).all() and np.isfinite(d.qvel).all()):
+            return "the physics state is not finite (the simulation diverged)"
+        q = d.qpos[ix.arm_qpos]
+        lo, hi = self._arm_range[:, 0], self._arm_range[:, 1]
+        over = np.flatnonzero((q < lo - 0.02) | (q > hi + 0.02))
+        if over.size:
+            j = int(over[0])
+            return f"PUMA joint {j + 1} is beyond its limit ({np.degrees(q[j]):.1f} deg)"
+        tensions = d.sensordata[ix.tension_sensors]
+        pinned = tensions >= ix.tension_limit - 1e-6
+        self._saturated_since[~pinned] = -1.0
+        self._saturated_since[pinned & (self._saturated_since < 0)] = self.time
+        long = np.flatnonzero(pinned & (self.time - self._saturated_since >= SATURATION_LIMIT_S))
+        if long.size:
+            k = int(long[0])
+            kind = "flexor" if k % 2 == 0 else "extensor"
+            joint = k // 2
+            return (
+                f"{FINGERS[joint // 4]} joint {joint % 4} {kind} tendon held at its "
+                f"{ix.tension_limit:g} N limit for {SATURATION_LIMIT_S:g} s"
+            )
+        return None
+
+
+class Slots:
+    """The command slots a run owns: it may write only its own effectors."""
+
+    def __init__(self, robot: MujocoRobot, effectors: frozenset[str]) -> None:
+        self.robot, self.effectors = robot, effectors
+
+    def _own(self, effector: str) -> None:
+        if effector not in self.effectors:
+            raise EffectorError(f"run does not own the {effector}")
+
+    def arm(self, q: FloatArray) -> None:
+        self._own("arm")
+        self.robot.arm_target = np.array(q, dtype=np.float64)
+
+    def joints(self, mask: int, q16: FloatArray) -> None:
+        """Set the hand joints selected by ``mask`` (bit 4*f + j) from ``q16``."""
+        bits = [k for k in range(16) if mask >> k & 1]
+        for f in {k // 4 for k in bits}:
+            self._own(FINGERS[f])
+        self.robot.hand_target[bits] = np.asarray(q16)[bits]
+
+    def limp(self, mask: int, on: bool) -> None:
+        bits = [k for k in range(16) if mask >> k & 1]
+        for f in {k // 4 for k in bits}:
+            self._own(FINGERS[f])
+        self.robot.limp[bits] = on
+        if not on:  # the joints hold where they went
+            self.robot.hand_target[bits] = self.robot.data.qpos[self.robot.index.hand_qpos[bits]]

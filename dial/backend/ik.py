@@ -1,0 +1,152 @@
+"""Inverse kinematics with mink on a robot-only copy of the model.
+
+The IK model holds only the arm and hand (no scene objects), so its QP stays at
+22 velocities whatever the scene holds. Solutions are warm-started from the last
+one: a straight-line move solves one waypoint per control period.
+"""
+
+from __future__ import annotations
+
+import mink
+import mujoco
+import numpy as np
+
+from dial.backend.model import RobotIndex, load_model
+from dial.backend.snapshot import FloatArray
+from dial.errors import DialError
+
+SOLVER = "daqp"
+DT = 0.01  # s: the differential step of one solve
+POS_TOL = 5e-4  # m
+ROT_TOL = 2e-3  # rad
+
+
+class IKError(DialError):
+    """A target the arm or a finger cannot reach; the message says how far off it stays."""
+
+
+class _Base:
+    def __init__(self) -> None:
+        self.model = load_model()
+        self.index = RobotIndex.from_model(self.model)
+        self.config = mink.Configuration(self.model)
+        self.limits = [mink.ConfigurationLimit(self.model)]
+
+    def _site(self, name: str) -> int:
+        return int(mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_SITE, name))
+
+
+class ArmIK(_Base):
+    """Tool-frame (``hand_palm``) IK over the six PUMA joints."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.task = mink.FrameTask("hand_palm", "site", position_cost=1.0, orientation_cost=0.2)
+        hand = [int(d) for d in self.index.hand_dof]
+        self.constraints = [mink.DofFreezingTask(self.model, dof_indices=hand)]
+
+    def fk(self, arm_q: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """Tool position (3,) and rotation (3, 3) at ``arm_q``."""
+        self._set(arm_q)
+        site = self.index.tool_site
+        d = self.config.data
+        return d.site_xpos[site].copy(), d.site_xmat[site].reshape(3, 3).copy()
+
+    def _set(self, arm_q: FloatArray) -> None:
+        q = self.config.q.copy()
+        q[self.index.arm_qpos] = arm_q
+        self.config.update(q)
+
+    def _iterate(self, pos: FloatArray, rot: FloatArray, iterations: int) -> tuple[float, float]:
+        target = mink.SE3.from_rotation_and_translation(mink.SO3.from_matrix(rot), pos)
+        self.task.set_target(target)
+        perr = rerr = np.inf
+        for _ in range(iterations):
+            err = self.task.compute_error(self.config)
+            perr, rerr = float(np.linalg.norm(err[:3])), float(np.linalg.norm(err[3:]))
+            if perr < POS_TOL and rerr < ROT_TOL:
+                break
+            vel = mink.solve_ik(
+                self.config,
+                [self.task],
+                DT,
+                SOLVER,
+                damping=1e-3,
+                limits=self.limits,
+                constraints=self.constraints,
+            )
+            self.config.integrate_inplace(vel, DT)
+        return perr, rerr
+
+    def track(
+        self, pos: FloatArray, rot: FloatArray, arm_q: FloatArray, iterations: int = 2
+    ) -> FloatArray:
+        """A few warm-started steps from ``arm_q`` toward the pose: one waypoint of a line."""
+        self._set(arm_q)
+        self._iterate(pos, rot, iterations)
+        return self.config.q[self.index.arm_qpos].copy()
+
+    def solve(self, pos: FloatArray, rot: FloatArray, arm_q: FloatArray, what: str) -> FloatArray:
+        """Converge on the pose from ``arm_q``; raise :class:`IKError` if it is out of reach."""
+        self._set(arm_q)
+        perr, rerr = self._iterate(pos, rot, 300)
+        if perr > 2e-3 or rerr > 1e-2:
+            raise IKError(
+                f"{what} is out of the arm's reach: the tool stays {perr * 1000:.1f} mm and "
+                f"{np.degrees(rerr):.1f} deg away"
+            )
+        return self.config.q[self.index.arm_qpos].copy()
+
+
+class FingerIK(_Base):
+    """Fingertip-position IK over one finger's four joints, the rest of the robot frozen."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        ix = self.index
+        self.tasks = [
+            mink.FrameTask(f"hand_{f}_tip", "site", position_cost=1.0, orientation_cost=0.0)
+            for f in ("index", "middle", "ring", "thumb")
+        ]
+        self.constraints = []
+        for f in range(4):
+            free = {int(d) for d in ix.hand_dof[4 * f : 4 * f + 4]}
+            frozen = [d for d in range(self.model.nv) if d not in free]
+            self.constraints.append(mink.DofFreezingTask(self.model, dof_indices=frozen))
+
+    def tip(self, arm_q: FloatArray, hand_q: FloatArray, finger: int) -> FloatArray:
+        self._set(arm_q, hand_q)
+        return self.config.data.site_xpos[self.index.fingertip_sites[finger]].copy()
+
+    def _set(self, arm_q: FloatArray, hand_q: FloatArray) -> None:
+        q = self.config.q.copy()
+        q[self.index.arm_qpos] = arm_q
+        q[self.index.hand_qpos] = hand_q
+        self.config.update(q)
+
+    def track(
+        self,
+        finger: int,
+        tip: FloatArray,
+        arm_q: FloatArray,
+        hand_q: FloatArray,
+        iterations: int = 2,
+    ) -> FloatArray:
+        """Steps from ``hand_q`` moving the fingertip toward ``tip`` (world, m); returns (16,)."""
+        self._set(arm_q, hand_q)
+        task = self.tasks[finger]
+        task.set_target(mink.SE3.from_translation(np.asarray(tip, dtype=np.float64)))
+        for _ in range(iterations):
+            if np.linalg.norm(task.compute_error(self.config)[:3]) < POS_TOL / 5:
+                break
+            vel = mink.solve_ik(
+                self.config,
+                [task],
+                DT,
+                SOLVER,
+                damping=1e-3,
+                limits=self.limits,
+                constraints=[self.constraints[finger]],
+            )
+            self.config.integrate_inplace(vel, DT)
+        return self.config.q[self.index.hand_qpos].copy()

@@ -1,0 +1,176 @@
+"""Arm motion: VAL-II programs and commands (puma_command) and relative moves (arm_move).
+
+A motion is planned at its start as segments (joint-interpolated or straight
+line) and time-scaled over the run's executing ticks in tick time. Straight
+lines solve one IK waypoint per control period, warm-started.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from dial.backend.snapshot import FloatArray, Snapshot
+from dial.primitives.context import Context, RobotPrimitive, rpy_matrix
+from dial.scene.valii import Appro, Depart, Drive, Move, Statement
+from dial.scheduler.types import Ended, Now, RunInfo
+
+JOINT_SPEED = 1.0  # rad/s: nominal, only to share a run's time among its segments
+LINEAR_SPEED = 0.25  # m/s
+TURN_SPEED = 1.0  # rad/s
+
+
+def smooth(u: float) -> float:
+    """Minimum-jerk time scaling of a segment: zero velocity and acceleration at both ends."""
+    u = min(1.0, max(0.0, u))
+    return u * u * u * (10.0 - 15.0 * u + 6.0 * u * u)
+
+
+def slerp(r0: FloatArray, r1: FloatArray, u: float) -> FloatArray:
+    """Rotation between ``r0`` and ``r1`` (u in [0, 1]) about their relative axis."""
+    rel = r0.T @ r1
+    angle = float(np.arccos(np.clip((np.trace(rel) - 1.0) / 2.0, -1.0, 1.0)))
+    if angle < 1e-9:
+        return r0.copy()
+    axis = np.array([rel[2, 1] - rel[1, 2], rel[0, 2] - rel[2, 0], rel[1, 0] - rel[0, 1]])
+    norm = np.linalg.norm(axis)
+    # A half turn has no antisymmetric part: its axis is the top eigenvector of rel + rel^T.
+    axis = np.linalg.eigh(rel + rel.T)[1][:, -1] if norm < 1e-9 else axis / norm
+    k = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+    a = angle * u
+    step = np.eye(3) + np.sin(a) * k + (1.0 - np.cos(a)) * (k @ k)
+    return r0 @ step
+
+
+@dataclass(frozen=True)
+class Segment:
+    """One piece of an arm motion: joint-interpolated, or a straight tool line."""
+
+    q0: FloatArray
+    q1: FloatArray
+    line: tuple[FloatArray, FloatArray, FloatArray, FloatArray] | None  # p0, r0, p1, r1
+    cost: float
+
+
+class Planner:
+    """Turns statements into segments, from a start configuration."""
+
+    def __init__(self, ctx: Context, q: FloatArray) -> None:
+        self.ctx, self.q = ctx, np.array(q, dtype=np.float64)
+        self.segments: list[Segment] = []
+
+    def joint_to(self, q1: FloatArray) -> None:
+        cost = float(np.abs(q1 - self.q).max()) / JOINT_SPEED
+        self.segments.append(Segment(self.q, q1, None, cost))
+        self.q = q1
+
+    def line_to(self, p1: FloatArray, r1: FloatArray, what: str) -> None:
+        p0, r0 = self.ctx.arm_ik.fk(self.q)
+        q1 = self.ctx.arm_ik.solve(p1, r1, self.q, what)
+        turn = float(np.arccos(np.clip((np.trace(r0.T @ r1) - 1.0) / 2.0, -1.0, 1.0)))
+        cost = max(float(np.linalg.norm(p1 - p0)) / LINEAR_SPEED, turn / TURN_SPEED)
+        self.segments.append(Segment(self.q, q1, (p0, r0, p1, r1), cost))
+        self.q = q1
+
+    def statement(self, st: Statement, where: str) -> None:
+        ik = self.ctx.arm_ik
+        if isinstance(st, Move):
+            pos, rot = self.ctx.location(st.location)
+            if st.straight:
+                self.line_to(pos, rot, f"location '{st.location}' ({where})")
+            else:
+                self.joint_to(ik.solve(pos, rot, self.q, f"location '{st.location}' ({where})"))
+        elif isinstance(st, Appro):
+            pos, rot = self.ctx.location(st.location)
+            pos = pos - st.distance * rot[:, 2]
+            self.joint_to(ik.solve(pos, rot, self.q, f"APPRO {st.location} ({where})"))
+        elif isinstance(st, Depart):
+            p0, r0 = ik.fk(self.q)
+            self.line_to(p0 - st.distance * r0[:, 2], r0, f"DEPART ({where})")
+        else:
+            q1 = self.q.copy()
+            q1[st.joint - 1] += st.angle
+            self.joint_to(q1)
+
+
+class ArmMotion(RobotPrimitive):
+    """Follows planned segments over the run's progress (tick time)."""
+
+    def __init__(self, ctx: Context, info: RunInfo) -> None:
+        super().__init__(ctx, info)
+        self.segments: list[Segment] = []
+        self.bounds: list[float] = []
+
+    def plan(self, planner: Planner) -> None:
+        raise NotImplementedError
+
+    def start(self, snapshot: Any) -> None:
+        assert isinstance(snapshot, Snapshot)
+        planner = Planner(self.ctx, snapshot.arm_target)
+        self.plan(planner)
+        self.segments = planner.segments
+        total = sum(s.cost for s in self.segments)
+        acc, self.bounds = 0.0, []
+        for s in self.segments:
+            acc += s.cost / total if total > 0 else 1.0 / len(self.segments)
+            self.bounds.append(acc)
+        self.q = snapshot.arm_target.copy()
+
+    def step(self, snapshot: Any, now: Now) -> Ended | None:
+        if not self.segments:
+            return None
+        start = 0.0
+        for seg, end in zip(self.segments, self.bounds, strict=True):
+            if now.progress <= end + 1e-12 or seg is self.segments[-1]:
+                u = smooth((now.progress - start) / max(end - start, 1e-12))
+                if seg.line is None:
+                    self.q = seg.q0 + (seg.q1 - seg.q0) * u
+                else:
+                    p0, r0, p1, r1 = seg.line
+                    warm = self.q if u < 1.0 else seg.q1
+                    self.q = self.ctx.arm_ik.track(p0 + (p1 - p0) * u, slerp(r0, r1, u), warm)
+                    if u >= 1.0:
+                        self.q = seg.q1
+                break
+            start = end
+        self.slots.arm(self.q)
+        return None
+
+
+class PumaCommand(ArmMotion):
+    """``puma_command "ex PROG" | "move LOC" | ...``: the VAL-II subset."""
+
+    def plan(self, planner: Planner) -> None:
+        verb = self.arg("verb")
+        if verb == "ex":
+            name = self.arg("program")
+            for st in self.ctx.world.programs[name].statements:
+                planner.statement(st, f"program {name}, line {st.line}")
+            return
+        line = 1
+        st: Statement
+        if verb in ("move", "moves"):
+            st = Move(line, self.arg("location"), verb == "moves")
+        elif verb == "appro":
+            st = Appro(line, self.arg("location"), self.arg("distance"))
+        elif verb == "depart":
+            st = Depart(line, self.arg("distance"))
+        else:
+            st = Drive(line, self.arg("joint"), self.arg("angle"))
+        planner.statement(st, verb)
+
+
+class ArmMove(ArmMotion):
+    """``arm_move DX DY DZ [RX RY RZ] [frame=tool|world]``: a relative straight line."""
+
+    def plan(self, planner: Planner) -> None:
+        p0, r0 = self.ctx.arm_ik.fk(planner.q)
+        d = np.array([self.arg("dx"), self.arg("dy"), self.arg("dz")], dtype=np.float64)
+        turn = rpy_matrix((self.arg("rx"), self.arg("ry"), self.arg("rz")))
+        if self.arg("frame") == "tool":
+            p1, r1 = p0 + r0 @ d, r0 @ turn
+        else:
+            p1, r1 = p0 + d, turn @ r0
+        planner.line_to(p1, r1, "the arm_move goal")

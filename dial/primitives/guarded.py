@@ -1,0 +1,78 @@
+"""``guarded_move``: move along a line until contact, checked at every physics step.
+
+The motion runs at ``speed`` in simulated time (a safe approach speed, not tick
+time), so a guarded move that outlasts its ticks stretches its last tick. The
+guard is armed in the driver, which freezes the effector at the physics step
+where the contact is first sensed; the run then ends ``done`` with the contact,
+or ``missed`` when it reaches ``max`` travel without one.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from dial.backend.snapshot import Snapshot
+from dial.instructions.types import FINGERS
+from dial.primitives.context import Context, RobotPrimitive, done, missed
+from dial.scheduler.types import Ended, Now, RunInfo
+
+
+class GuardedMove(RobotPrimitive):
+    def __init__(self, ctx: Context, info: RunInfo) -> None:
+        super().__init__(ctx, info)
+        finger = self.arg("finger")
+        self.finger: int | None = None if finger is None else int(finger)
+        d = np.array([self.arg("dx"), self.arg("dy"), self.arg("dz")], dtype=np.float64)
+        self.length = float(self.arg("max") or np.linalg.norm(d))
+        self.direction = d / np.linalg.norm(d)
+        self.speed = float(self.arg("speed"))
+        sense = self.arg("sense")
+        if sense is not None:
+            self.sense: tuple[int, ...] = (int(sense),)
+        else:
+            self.sense = (self.finger,) if self.finger is not None else tuple(range(4))
+        self.guard = 0
+
+    def start(self, snapshot: Any) -> None:
+        assert isinstance(snapshot, Snapshot)
+        frame = self.arg("frame") or ("tool" if self.finger is None else "palm")
+        world = frame == "world"
+        self.delta = self.direction if world else snapshot.tool_rot @ self.direction
+        self.arm_q = snapshot.arm_target.copy()
+        self.hand = snapshot.hand_target.copy()
+        ik = self.ctx.arm_ik
+        if self.finger is None:
+            self.p0, self.r0 = ik.fk(self.arm_q)
+        else:
+            self.p0 = self.ctx.finger_ik.tip(self.arm_q, self.hand, self.finger)
+        effector = "arm" if self.finger is None else FINGERS[self.finger]
+        self.guard = self.ctx.robot.arm_guard(effector, self.arg("until"), self.sense)
+
+    def step(self, snapshot: Any, now: Now) -> Ended | None:
+        assert isinstance(snapshot, Snapshot)
+        trip = snapshot.trips.get(self.guard)
+        travel = min(self.speed * (now.elapsed - self.info.period), self.length)
+        if trip is not None:
+            return done(
+                kind=trip.kind,
+                finger=FINGERS[trip.finger],
+                value=trip.value,
+                time=trip.time,
+                step=trip.step,
+                travel=travel,
+            )
+        if travel >= self.length:
+            return missed(f"no contact within {self.length * 1000:.0f} mm", travel=travel)
+        goal = self.p0 + self.delta * (travel + self.speed * self.info.period)
+        if self.finger is None:
+            self.arm_q = self.ctx.arm_ik.track(goal, self.r0, self.arm_q)
+            self.slots.arm(self.arm_q)
+        else:
+            self.hand = self.ctx.finger_ik.track(self.finger, goal, self.arm_q, self.hand)
+            self.slots.joints(0xF << (4 * self.finger), self.hand)
+        return None
+
+    def stop(self) -> None:
+        self.ctx.robot.disarm(self.guard)

@@ -1,0 +1,125 @@
+"""Hand primitives: named poses, grasp with force, limp, and Cartesian fingertip moves."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from dial.backend.snapshot import FloatArray, Snapshot
+from dial.primitives.arm import smooth
+from dial.primitives.context import Context, RobotPrimitive, done, missed
+from dial.scheduler.types import Ended, Now, RunInfo
+
+
+def _bits(mask: int) -> list[int]:
+    return [k for k in range(16) if mask >> k & 1]
+
+
+class HandPose(RobotPrimitive):
+    """``hand_pose "NAME" [fingers=MASK]``: GOTO for ``#``, interpolated for ``#===``."""
+
+    def start(self, snapshot: Any) -> None:
+        assert isinstance(snapshot, Snapshot)
+        pose = self.ctx.world.poses[self.arg("pose")]
+        fingers = self.arg("fingers")
+        self.mask = pose.mask & (fingers if fingers is not None else 0xFFFF)
+        self.q0 = snapshot.hand_target.copy()
+        self.q1 = self.q0.copy()
+        for bit, angle in pose.angles.items():
+            self.q1[bit] = angle
+
+    def step(self, snapshot: Any, now: Now) -> Ended | None:
+        self.slots.joints(self.mask, self.q0 + (self.q1 - self.q0) * smooth(now.progress))
+        return None
+
+
+class GraspForce(RobotPrimitive):
+    """``grasp_force "JMASK_TMASK FORCE"`` (the paper's GRASP WITH FORCE).
+
+    The joints in JMASK close at ``speed``. A finger stops closing when any of
+    its tendon-masked joints feels a flexor-minus-extensor tension of FORCE (a
+    finger with no tendon-masked joint stops when any of its own joints does).
+    The run is done when every finger with a tendon-masked joint has stopped,
+    and missed if they all reach their joint limits first.
+    """
+
+    def start(self, snapshot: Any) -> None:
+        assert isinstance(snapshot, Snapshot)
+        self.jmask, self.tmask = self.arg("masks")
+        self.force = float(self.arg("force"))
+        self.rate = float(self.arg("speed")) * self.info.period
+        self.target = snapshot.hand_target.copy()
+        self.upper = self.ctx.robot.hand_range[:, 1]
+        self.fingers = sorted({k // 4 for k in _bits(self.jmask)})
+        self.watched = {
+            f: [k for k in _bits(self.tmask) if k // 4 == f]
+            or [k for k in _bits(self.jmask) if k // 4 == f]
+            for f in self.fingers
+        }
+        self.stopped: dict[int, float] = {}
+
+    def step(self, snapshot: Any, now: Now) -> Ended | None:
+        assert isinstance(snapshot, Snapshot)
+        diff = snapshot.differentials
+        for f in self.fingers:
+            if f not in self.stopped and max(diff[k] for k in self.watched[f]) >= self.force:
+                self.stopped[f] = now.sim_time
+        closing = [k for k in _bits(self.jmask) if k // 4 not in self.stopped]
+        self.target[closing] = np.minimum(self.target[closing] + self.rate, self.upper[closing])
+        self.slots.joints(self.jmask, self.target)
+        monitored = {k // 4 for k in _bits(self.tmask)} or set(self.fingers)
+        forces = {f"j{k}": float(diff[k]) for k in _bits(self.tmask)}
+        if monitored <= set(self.stopped):
+            return done(forces=forces)
+        if all(self.target[k] >= self.upper[k] for k in closing) and not monitored & set(
+            self.stopped
+        ):
+            return missed("the fingers closed fully without reaching the force", forces=forces)
+        return None
+
+
+class Limp(RobotPrimitive):
+    """``limp [fingers=MASK] [save=NAME]``: back-drivable joints; the reached pose is recorded."""
+
+    def __init__(self, ctx: Context, info: RunInfo) -> None:
+        super().__init__(ctx, info)
+        self.mask = int(self.arg("fingers"))
+
+    def start(self, snapshot: Any) -> None:
+        self.slots.limp(self.mask, True)
+
+    def step(self, snapshot: Any, now: Now) -> Ended | None:
+        return None
+
+    def finish(self, snapshot: Any) -> Ended:
+        assert isinstance(snapshot, Snapshot)
+        self.slots.limp(self.mask, False)
+        pose = {f"j{k}": float(np.degrees(snapshot.hand_q[k])) for k in _bits(self.mask)}
+        save = self.arg("save")
+        return done(pose_deg=pose, **({"saved_as": save} if save else {}))
+
+    def stop(self) -> None:  # cancelled mid-run: stiffen where the joints are
+        if self.ctx.robot.limp[_bits(self.mask)].any():
+            self.slots.limp(self.mask, False)
+
+
+class FingerMove(RobotPrimitive):
+    """``finger_move finger=F DX DY DZ [frame=palm|world]``: a straight fingertip line by IK."""
+
+    def start(self, snapshot: Any) -> None:
+        assert isinstance(snapshot, Snapshot)
+        self.finger = int(self.arg("finger"))
+        self.arm_q = snapshot.arm_target.copy()
+        self.hand = snapshot.hand_target.copy()
+        ik = self.ctx.finger_ik
+        self.tip0 = ik.tip(self.arm_q, self.hand, self.finger)
+        d = np.array([self.arg("dx"), self.arg("dy"), self.arg("dz")], dtype=np.float64)
+        self.delta: FloatArray = snapshot.tool_rot @ d if self.arg("frame") == "palm" else d
+        self.mask = 0xF << (4 * self.finger)
+
+    def step(self, snapshot: Any, now: Now) -> Ended | None:
+        goal = self.tip0 + self.delta * smooth(now.progress)
+        self.hand = self.ctx.finger_ik.track(self.finger, goal, self.arm_q, self.hand)
+        self.slots.joints(self.mask, self.hand)
+        return None

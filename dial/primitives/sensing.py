@@ -1,0 +1,143 @@
+"""Sensing: snapshots into the log, contact waits, contact points and fits."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import mujoco
+import numpy as np
+
+from dial.backend.driver import POSITION_LEVER
+from dial.backend.snapshot import FloatArray, Snapshot
+from dial.instructions.types import FINGERS
+from dial.primitives.context import Context, RobotPrimitive, done, missed
+from dial.scheduler.types import Ended, InstantPrimitive, Now, Outcome, RunInfo
+
+
+class Get(InstantPrimitive):
+    """``get_joints``, ``get_forces``, ``get_tactile``, ``get_wrist``: record a snapshot."""
+
+    def __init__(self, ctx: Context, info: RunInfo) -> None:
+        self.what = info.event.instruction.name
+
+    def sense(self, snapshot: Any) -> Ended:
+        assert isinstance(snapshot, Snapshot)
+        if self.what == "get_joints":
+            return done(hand_q=snapshot.hand_q, arm_q=snapshot.arm_q)
+        if self.what == "get_forces":
+            return done(tensions=snapshot.tensions)
+        if self.what == "get_tactile":
+            return done(tactile=snapshot.tactile)
+        return done(pos=snapshot.tool_pos, rot=snapshot.tool_rot)
+
+
+def contact_value(kind: str, snapshot: Snapshot, finger: int, baseline: FloatArray | None) -> float:
+    """The reading a contact condition compares with its threshold (m or N)."""
+    joints = slice(4 * finger, 4 * finger + 4)
+    if kind == "tactile":
+        return float(snapshot.tactile[finger].max())
+    if kind == "force":
+        diff = snapshot.differentials[joints]
+        return float(np.abs(diff - (baseline[joints] if baseline is not None else 0.0)).max())
+    err = snapshot.hand_target[joints] - snapshot.hand_q[joints]
+    return float(np.linalg.norm(err)) * POSITION_LEVER
+
+
+class ContactWait(RobotPrimitive):
+    """``position_contact``, ``force_contact``, ``tactile_contact``: wait for the signal."""
+
+    def __init__(self, ctx: Context, info: RunInfo) -> None:
+        super().__init__(ctx, info)
+        self.kind = info.event.instruction.name.removesuffix("_contact")
+        self.finger = int(self.arg("finger"))
+        self.threshold = float(self.arg("threshold"))
+
+    def start(self, snapshot: Any) -> None:
+        assert isinstance(snapshot, Snapshot)
+        self.baseline = snapshot.differentials.copy()
+
+    def step(self, snapshot: Any, now: Now) -> Ended | None:
+        assert isinstance(snapshot, Snapshot)
+        value = contact_value(self.kind, snapshot, self.finger, self.baseline)
+        return done(value=value) if value >= self.threshold else None
+
+
+class ContactTest(InstantPrimitive):
+    """A contact wait used as a condition-only event: is there contact now?"""
+
+    def __init__(self, ctx: Context, info: RunInfo) -> None:
+        self.kind = info.event.instruction.name.removesuffix("_contact")
+        self.finger = int(info.event.args["finger"])
+        self.threshold = float(info.event.args["threshold"])
+
+    def sense(self, snapshot: Any) -> Ended:
+        assert isinstance(snapshot, Snapshot)
+        value = contact_value(self.kind, snapshot, self.finger, None)
+        if value >= self.threshold:
+            return done(value=value)
+        return missed(f"no {self.kind} contact on the {FINGERS[self.finger]}", value=value)
+
+
+def taxel_points(ctx: Context, finger: int) -> FloatArray:
+    """(256, 3) world positions of a fingertip's taxels, in sensor order."""
+    model, data = ctx.robot.model, ctx.robot.data
+    sensor = int(
+        mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SENSOR, f"hand_{FINGERS[finger]}_tactile")
+    )
+    geom = int(model.sensor_objid[sensor])
+    mesh = int(model.geom_dataid[geom])
+    adr, n = int(model.mesh_vertadr[mesh]), int(model.mesh_vertnum[mesh])
+    local = model.mesh_vert[adr : adr + n].astype(np.float64)
+    rot = data.geom_xmat[geom].reshape(3, 3)
+    return data.geom_xpos[geom] + local @ rot.T
+
+
+class RecordContact(InstantPrimitive):
+    """``record_contact finger=F [into=SET]``: the depth-weighted taxel centroid, world frame."""
+
+    def __init__(self, ctx: Context, info: RunInfo) -> None:
+        self.ctx = ctx
+        self.finger = int(info.event.args["finger"])
+        self.set = str(info.event.args["into"])
+
+    def sense(self, snapshot: Any) -> Ended:
+        assert isinstance(snapshot, Snapshot)
+        depth = snapshot.tactile[self.finger].reshape(-1)
+        if depth.max() <= 0.0:
+            return missed(f"the {FINGERS[self.finger]} fingertip touches nothing")
+        points = taxel_points(self.ctx, self.finger)
+        point = (depth @ points) / depth.sum()
+        self.ctx.point_sets.setdefault(self.set, []).append([float(x) for x in point])
+        return done(point=point, set=self.set, count=len(self.ctx.point_sets[self.set]))
+
+
+class Fit(InstantPrimitive):
+    """``fit_plane SET`` and ``fit_superquadric SET``: least squares over a point set."""
+
+    def __init__(self, ctx: Context, info: RunInfo) -> None:
+        self.ctx = ctx
+        self.set = str(info.event.args["set"])
+        self.kind = info.event.instruction.name
+
+    def sense(self, snapshot: Any) -> Ended:
+        from dial.haptics import FitError, fit_plane, fit_superquadric
+
+        points = np.array(self.ctx.point_sets.get(self.set, []), dtype=np.float64).reshape(-1, 3)
+        try:
+            fit = fit_plane(points) if self.kind == "fit_plane" else fit_superquadric(points)
+        except FitError as e:
+            return Ended(Outcome.MISSED, f"point set '{self.set}': {e}")
+        result = fit.as_result()
+        self.ctx.results[self.set] = result
+        return done(set=self.set, points=len(points), **result)
+
+
+def make_sensing(ctx: Context, info: RunInfo) -> Any:
+    name = info.event.instruction.name
+    if name.startswith("get_"):
+        return Get(ctx, info)
+    if name == "record_contact":
+        return RecordContact(ctx, info)
+    if name.startswith("fit_"):
+        return Fit(ctx, info)
+    return ContactTest(ctx, info) if info.instant else ContactWait(ctx, info)
