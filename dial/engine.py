@@ -18,10 +18,12 @@ import numpy as np
 import trio
 
 from dial.backend.driver import MujocoRobot
+from dial.backend.ik import ArmIK
 from dial.backend.model import ARM_HOME, RobotIndex, hand_ctrl, load_model
 from dial.errors import DialError
 from dial.parser.check import Script
 from dial.primitives import Context, make_factory
+from dial.primitives.context import location_pose, rpy_matrix
 from dial.scene.evaluate import measure
 from dial.scene.resolve import resolve_scene
 from dial.scene.world import World, load_world
@@ -30,6 +32,9 @@ from dial.scheduler.runner import Runner, RunSummary
 
 DEFAULT_TICK = 0.25  # s, when neither the script (@tick) nor the command line sets one
 SETTLE_S = 0.5  # objects settle on the table before the script starts
+# Where the tool starts when the world file has no "home" location: high above the tables,
+# pointing down (world m; rpy as in world files).
+START = ((0.40, 0.0, 0.80), (np.pi, 0.0, 0.0))
 
 
 @dataclass
@@ -111,14 +116,20 @@ def prepare(script: Script, options: RunOptions, log: EventLog) -> tuple[MujocoR
     model = load_model(world.model_path)
     data = mujoco.MjData(model)
     index = RobotIndex.from_model(model)
-    data.qpos[index.arm_qpos] = ARM_HOME
-    data.ctrl[index.arm_actuators] = ARM_HOME
-    data.ctrl[index.tendon_actuators] = hand_ctrl(data.qpos[index.hand_qpos])
     mujoco.mj_forward(model, data)
     believed = {
         model.body(b).name: (data.xpos[b].copy(), data.xmat[b].reshape(3, 3).copy())
         for b in _scene_bodies(model, world)
     }
+    ik = ArmIK()
+    if "home" in world.locations:
+        pos, rot = location_pose(world, believed, "home")
+    else:
+        pos, rot = np.array(START[0]), rpy_matrix(START[1])
+    home = ik.solve(pos, rot, np.array(ARM_HOME), "the start pose (location 'home')")
+    data.qpos[index.arm_qpos] = home
+    data.ctrl[index.arm_actuators] = home
+    data.ctrl[index.tendon_actuators] = hand_ctrl(data.qpos[index.hand_qpos])
     shift = _perturb(model, data, world, options.perturb_mm, options.seed)
     mujoco.mj_forward(model, data)
     for _ in range(round(SETTLE_S / model.opt.timestep)):
@@ -127,8 +138,7 @@ def prepare(script: Script, options: RunOptions, log: EventLog) -> tuple[MujocoR
         "scene", scene=world.name, world=str(world.path.name), perturb=shift, seed=options.seed
     )
     robot = MujocoRobot(model, data, log)
-    robot.steps = 0
-    return robot, Context(robot, world, believed)
+    return robot, Context(robot, world, believed, ik)
 
 
 def run(script: Script, options: RunOptions) -> RunResult:

@@ -24,8 +24,9 @@ from dial.scene.thread import Thread, find_threads
 from dial.scheduler.log import EventLog
 
 CONTROL_PERIOD = 0.01  # s; physics runs at the model's timestep (0.002 s)
-SATURATION_LIMIT_S = 1.0  # a tendon pinned at its tension limit this long is a fault
+SATURATION_LIMIT_S = 1.0  # a tendon pinned at its tension limit this long is logged
 POSITION_LEVER = 0.1  # m: joint error (rad) to fingertip displacement, about a finger length
+LIMIT_SLACK = 0.05  # rad: the servo may press a joint this far into its limit stop
 
 
 class EffectorError(DialError):
@@ -68,6 +69,7 @@ class MujocoRobot:
         self._next_guard = 0
         self._trips: dict[int, Trip] = {}
         self._saturated_since = np.full(32, -1.0)
+        self._saturation_logged = np.zeros(32, dtype=bool)
         self._tactile_adr = [int(a) for a in ix.tactile_sensors]
         self._arm_range = model.jnt_range[model.actuator_trnid[ix.arm_actuators, 0]]
         hand_joints = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, n) for n in HAND_JOINTS]
@@ -200,7 +202,7 @@ class MujocoRobot:
         self.log.write(
             "contact",
             effector=guard.effector,
-            kind=trip.kind,
+            sensor=trip.kind,
             finger=FINGERS[trip.finger],
             value=trip.value,
             t=trip.time,
@@ -214,23 +216,27 @@ class MujocoRobot:
             return "the physics state is not finite (the simulation diverged)"
         q = d.qpos[ix.arm_qpos]
         lo, hi = self._arm_range[:, 0], self._arm_range[:, 1]
-        over = np.flatnonzero((q < lo - 0.02) | (q > hi + 0.02))
+        over = np.flatnonzero((q < lo - LIMIT_SLACK) | (q > hi + LIMIT_SLACK))
         if over.size:
             j = int(over[0])
             return f"PUMA joint {j + 1} is beyond its limit ({np.degrees(q[j]):.1f} deg)"
+        # A tendon pinned at its limit is not a fault (a fist pressed into the palm does it),
+        # but a researcher should know: log it once per episode.
         tensions = d.sensordata[ix.tension_sensors]
         pinned = tensions >= ix.tension_limit - 1e-6
         self._saturated_since[~pinned] = -1.0
         self._saturated_since[pinned & (self._saturated_since < 0)] = self.time
-        long = np.flatnonzero(pinned & (self.time - self._saturated_since >= SATURATION_LIMIT_S))
-        if long.size:
-            k = int(long[0])
-            kind = "flexor" if k % 2 == 0 else "extensor"
-            joint = k // 2
-            return (
-                f"{FINGERS[joint // 4]} joint {joint % 4} {kind} tendon held at its "
-                f"{ix.tension_limit:g} N limit for {SATURATION_LIMIT_S:g} s"
+        held = pinned & (self.time - self._saturated_since >= SATURATION_LIMIT_S)
+        for k in np.flatnonzero(held & ~self._saturation_logged):
+            joint = int(k) // 2
+            self.log.write(
+                "warning",
+                t=self.time,
+                message=f"{FINGERS[joint // 4]} joint {joint % 4} "
+                f"{'flexor' if k % 2 == 0 else 'extensor'} tendon held at its "
+                f"{ix.tension_limit:g} N limit for {SATURATION_LIMIT_S:g} s",
             )
+        self._saturation_logged = held | (self._saturation_logged & pinned)
         return None
 
 

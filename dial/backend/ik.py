@@ -87,15 +87,48 @@ class ArmIK(_Base):
         return self.config.q[self.index.arm_qpos].copy()
 
     def solve(self, pos: FloatArray, rot: FloatArray, arm_q: FloatArray, what: str) -> FloatArray:
-        """Converge on the pose from ``arm_q``; raise :class:`IKError` if it is out of reach."""
-        self._set(arm_q)
-        perr, rerr = self._iterate(pos, rot, 300)
-        if perr > 2e-3 or rerr > 1e-2:
+        """Converge on the pose; raise :class:`IKError` if it is out of reach.
+
+        Differential IK from ``arm_q`` can stall against a joint limit far from the goal, so
+        a few fixed wrist and elbow variations of the start are tried as well, and the
+        solution nearest ``arm_q`` among those that converge wins. Deterministic.
+        """
+        start = np.asarray(arm_q, dtype=np.float64)
+        best: tuple[float, FloatArray] | None = None
+        closest = (np.inf, np.inf)
+        for offset in _SEEDS:
+            self._set(start + offset)
+            perr, rerr = self._iterate(pos, rot, 200)
+            q = self.config.q[self.index.arm_qpos].copy()
+            if perr <= 2e-3 and rerr <= 1e-2:
+                distance = float(np.abs(q - start).max())
+                if best is None or distance < best[0] - 1e-9:
+                    best = (distance, q)
+                if distance < 0.5:
+                    break  # near the start: no other seed can be much nearer
+            elif perr < closest[0]:
+                closest = (perr, rerr)
+        if best is None:
             raise IKError(
-                f"{what} is out of the arm's reach: the tool stays {perr * 1000:.1f} mm and "
-                f"{np.degrees(rerr):.1f} deg away"
+                f"{what} is out of the arm's reach: the tool stays {closest[0] * 1000:.1f} mm "
+                f"and {np.degrees(closest[1]):.1f} deg away"
             )
-        return self.config.q[self.index.arm_qpos].copy()
+        return best[1]
+
+
+# Start offsets for ArmIK.solve: as given, then wrist (joints 4 and 6) and elbow variations.
+_SEEDS: tuple[FloatArray, ...] = tuple(
+    np.array(o, dtype=np.float64)
+    for o in (
+        (0, 0, 0, 0, 0, 0),
+        (0, 0, 0, np.pi / 2, 0, -np.pi / 2),
+        (0, 0, 0, -np.pi / 2, 0, np.pi / 2),
+        (0, 0, 0, 0, 0, np.pi),
+        (0, 0, 0, 0, 0, -np.pi),
+        (0, -0.5, 0.5, 0, 0.5, 0),
+        (0, 0.5, -0.5, 0, -0.5, 0),
+    )
+)
 
 
 class FingerIK(_Base):
@@ -135,7 +168,13 @@ class FingerIK(_Base):
         """Steps from ``hand_q`` moving the fingertip toward ``tip`` (world, m); returns (16,)."""
         self._set(arm_q, hand_q)
         task = self.tasks[finger]
-        task.set_target(mink.SE3.from_translation(np.asarray(tip, dtype=np.float64)))
+        # Position only: keep the tip's own orientation in the target, since mink's frame error
+        # mixes rotation into the translation part when the two disagree.
+        site = self.index.fingertip_sites[finger]
+        rot = mink.SO3.from_matrix(self.config.data.site_xmat[site].reshape(3, 3))
+        task.set_target(
+            mink.SE3.from_rotation_and_translation(rot, np.asarray(tip, dtype=np.float64))
+        )
         for _ in range(iterations):
             if np.linalg.norm(task.compute_error(self.config)[:3]) < POS_TOL / 5:
                 break

@@ -28,6 +28,7 @@ SUPERQUADRIC_MIN_POINTS = 11  # one per parameter: 3 sizes, 2 shapes, 3 translat
 # Starting exponents (eps1, eps2): square-edged and ellipsoidal. Each is tried with each
 # principal axis as the superquadric's z axis, because a cylinder fits only along its own axis.
 DEFAULT_STARTS: tuple[tuple[float, float], ...] = ((0.3, 0.3), (1.0, 1.0))
+TIE_RTOL = 1e-6  # costs this close (relative) are the same fit
 
 
 class FitError(ValueError):
@@ -61,7 +62,7 @@ class PlaneFit:
             "axes": [_floats(a) for a in self.axes],
             "rms_residual": self.rms_residual,
             "max_residual": self.max_residual,
-            "points": self.count,
+            "count": self.count,
         }
 
 
@@ -94,7 +95,7 @@ class SuperquadricFit:
             "rotation": [_floats(row) for row in self.rotation],
             "rms_residual": self.rms_residual,
             "cost": self.cost,
-            "points": self.count,
+            "count": self.count,
         }
 
 
@@ -153,6 +154,8 @@ def fit_superquadric(
     lowest cost wins. Raises :class:`FitError` for fewer than 11 points (one per parameter),
     non-finite values, or points that span no volume (collinear or coplanar).
     """
+    if not starts:
+        raise ValueError("starts must name at least one (eps1, eps2) pair")
     p = _points(points, SUPERQUADRIC_MIN_POINTS, "a superquadric")
     # Work in units of the points' rms radius, so sizes, centre and rotation are all ~1.
     origin = p.mean(axis=0)
@@ -176,11 +179,13 @@ def fit_superquadric(
         if np.linalg.det(frame) < 0.0:
             frame[:, 0] = -frame[:, 0]
         sizes = half[[x_axis, y_axis, z_axis]]
-        for shape in starts:
-            x, cost = _solve(q, frame, np.concatenate([sizes, shape, mid]), size_bounds)
-            if best is None or cost < best[0]:
+        for start in starts:
+            cost, x = _solve(q, frame, np.concatenate([sizes, start, mid]), size_bounds)
+            # Boxes and ellipsoids fit equally well with any axis as z: a near-tie keeps the
+            # earlier start, so that rounding does not decide which axis is reported as z.
+            if best is None or cost < best[0] * (1.0 - TIE_RTOL):
                 best = (cost, x, frame)
-    assert best is not None  # starts is not empty; checked in _points' caller contract
+    assert best is not None
     cost, x, frame = best
     size, shape, centre = x[0:3], x[3:5], x[5:8]
     rotation = frame @ Rotation.from_rotvec(x[8:11]).as_matrix()
@@ -211,7 +216,8 @@ def _solve(
         rotation = frame @ Rotation.from_rotvec(x[8:11]).as_matrix()
         local = (q - x[5:8]) @ rotation
         size, shape = x[0:3], x[3:5]
-        return np.sqrt(np.prod(size)) * (np.exp(shape[0] * _log_f(local, size, shape)) - 1.0)
+        inside_outside = np.exp(shape[0] * _log_f(local, size, shape))  # F^e1
+        return np.asarray(np.sqrt(np.prod(size)) * (inside_outside - 1.0))
 
     done = least_squares(residuals, x0, bounds=(lower, upper), x_scale="jac", max_nfev=2000)
     return float(done.cost), np.asarray(done.x, dtype=float)

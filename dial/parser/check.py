@@ -122,18 +122,18 @@ class _Checker:
             return
         bound, errors = bind(instr, d)
         for span, message in errors:
-            self.error(span, message)
+            self.error(span, f"event '{d.event}': {message}")
         if errors:
             self.broken.add(d.event)
             return
-        if self.scene is not None and not self.scene_names(instr, bound.args, bound.spans):
+        if self.scene is not None and not self.scene_names(d.event, instr, bound.args, bound.spans):
             self.broken.add(d.event)
             return
         effectors = instr.effectors(bound.args, self.scene)
         self.events[d.event] = EventDef(d.event, instr, bound.args, effectors, d)
 
     def scene_names(
-        self, instr: Instruction, args: Mapping[str, object], spans: Mapping[str, Span]
+        self, event: str, instr: Instruction, args: Mapping[str, object], spans: Mapping[str, Span]
     ) -> bool:
         assert self.scene is not None
         ok = True
@@ -157,7 +157,7 @@ class _Checker:
             ok = False
             self.error(
                 spans[spec.name],
-                f"unknown {kind} '{value}' in scene '{self.scene.name}'"
+                f"event '{event}': unknown {kind} '{value}' in scene '{self.scene.name}'"
                 f"{_hint(str(value), known)}{_choices(known)}",
             )
         return ok

@@ -27,6 +27,23 @@ def rpy_matrix(rpy: tuple[float, float, float]) -> FloatArray:
     )
 
 
+def location_pose(
+    world: World, believed: dict[str, tuple[FloatArray, FloatArray]], name: str
+) -> tuple[FloatArray, FloatArray]:
+    """A named location's tool pose in the world: position (3,), rotation (3, 3).
+
+    An object-relative location follows the object's *believed* pose.
+    """
+    loc: Location = world.locations[name]
+    pos, rot = np.array(loc.pos, dtype=np.float64), rpy_matrix(loc.rpy)
+    if loc.body is None:
+        return pos, rot
+    body_pos, body_rot = believed[loc.body]
+    if loc.axes == "world":
+        return body_pos + pos, rot
+    return body_pos + body_rot @ pos, body_rot @ rot
+
+
 @dataclass
 class Context:
     """Shared by the primitives of one run.
@@ -45,15 +62,7 @@ class Context:
     results: dict[str, dict[str, Any]] = field(default_factory=dict)
 
     def location(self, name: str) -> tuple[FloatArray, FloatArray]:
-        """A named location's tool pose in the world: position (3,), rotation (3, 3)."""
-        loc: Location = self.world.locations[name]
-        pos, rot = np.array(loc.pos, dtype=np.float64), rpy_matrix(loc.rpy)
-        if loc.body is None:
-            return pos, rot
-        body_pos, body_rot = self.believed[loc.body]
-        if loc.axes == "world":
-            return body_pos + pos, rot
-        return body_pos + body_rot @ pos, body_rot @ rot
+        return location_pose(self.world, self.believed, name)
 
 
 class RobotPrimitive(Primitive):

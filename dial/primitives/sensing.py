@@ -9,6 +9,7 @@ import numpy as np
 
 from dial.backend.driver import POSITION_LEVER
 from dial.backend.snapshot import FloatArray, Snapshot
+from dial.haptics import FitError, fit_plane, fit_superquadric
 from dial.instructions.types import FINGERS
 from dial.primitives.context import Context, RobotPrimitive, done, missed
 from dial.scheduler.types import Ended, InstantPrimitive, Now, Outcome, RunInfo
@@ -120,8 +121,6 @@ class Fit(InstantPrimitive):
         self.kind = info.event.instruction.name
 
     def sense(self, snapshot: Any) -> Ended:
-        from dial.haptics import FitError, fit_plane, fit_superquadric
-
         points = np.array(self.ctx.point_sets.get(self.set, []), dtype=np.float64).reshape(-1, 3)
         try:
             fit = fit_plane(points) if self.kind == "fit_plane" else fit_superquadric(points)

@@ -112,8 +112,10 @@ class Runner:
         return self.periods * self.period
 
     async def run(self, script: Script) -> RunSummary:
+        """Run the script; an abort is reported in the summary, an interrupt re-raised."""
         self._root = script.path
         error: RunAborted | None = None
+        interrupted = False
         try:
             async with trio.open_nursery() as nursery:
                 self._nursery = nursery
@@ -121,17 +123,19 @@ class Runner:
                     await self._steps(script, script.timeline)
                 except RunAborted as e:
                     error = e
-                    self.robot.hold_all()
                     self.log.write(
                         "error", event=e.event, tick=e.tick, t=self.sim_time, message=str(e)
                     )
+                except KeyboardInterrupt:
+                    interrupted = True
+                    self.log.write("interrupted", tick=self.tick, t=self.sim_time)
+                finally:
+                    self.robot.hold_all()  # on abort, interrupt or bug: the arm never drops
                     nursery.cancel_scope.cancel()
-                except BaseException:
-                    self.robot.hold_all()  # interrupts too: the arm never drops
-                    nursery.cancel_scope.cancel()
-                    raise
         finally:
             self._nursery = None
+        if interrupted:
+            raise KeyboardInterrupt
         return RunSummary(
             error is None,
             error,
