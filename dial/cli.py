@@ -118,9 +118,8 @@ def cmd_run(args: argparse.Namespace) -> int:
     tick = tick_length(script, options)
     try:
         result = run(script, options)
-    except KeyboardInterrupt:
+    except KeyboardInterrupt:  # the runner has logged it and every effector holds
         if log_file is not None:
-            log_file.write(json.dumps({"kind": "interrupted"}) + "\n")
             log_file.close()
         print("dial: interrupted; every effector holds its pose", file=sys.stderr)
         return 130
