@@ -34,3 +34,18 @@ def test_readme_lists_every_subcommand() -> None:
     sub = next(a for a in build_parser()._actions if a.dest == "command")
     for name in sub.choices:  # type: ignore[union-attr]
         assert f"`dial {name}" in readme, name
+
+
+def test_instruction_reference_covers_every_instruction_and_parameter() -> None:
+    from dial.instructions import INSTRUCTIONS
+
+    doc = (ROOT / "docs" / "instructions.md").read_text(encoding="utf-8")
+    headings = [line for line in doc.splitlines() if line.startswith("## ")]
+    for name, instr in INSTRUCTIONS.items():
+        assert any(f"`{name}" in h for h in headings), name
+        for spec in instr.params:
+            if spec.name in ("verb", "masks", "pose", "set", "dx", "dy", "dz", "rx", "ry", "rz"):
+                continue  # positional: shown in the usage line
+            assert f"{spec.name}=" in doc or f"`{spec.name}`" in doc, (name, spec.name)
+        for verb in instr.verbs:
+            assert f"`{verb} " in doc or f'"{verb} ' in doc, verb
