@@ -79,7 +79,7 @@ class MujocoRobot:
     # -- the scheduler's robot protocol ---------------------------------------------------------
     @property
     def period(self) -> float:
-        return self._period
+        return float(self._period)
 
     def snapshot(self) -> Snapshot:
         d, ix = self.data, self.index
@@ -133,7 +133,7 @@ class MujocoRobot:
     # -- commands ----------------------------------------------------------------------------------
     @property
     def time(self) -> float:
-        return self.steps * self.model.opt.timestep
+        return self.steps * float(self.model.opt.timestep)
 
     def tactile(self) -> FloatArray:
         """(4, 16, 16) taxel depths (m)."""

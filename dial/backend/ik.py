@@ -149,7 +149,8 @@ class FingerIK(_Base):
 
     def tip(self, arm_q: FloatArray, hand_q: FloatArray, finger: int) -> FloatArray:
         self._set(arm_q, hand_q)
-        return self.config.data.site_xpos[self.index.fingertip_sites[finger]].copy()
+        tip: FloatArray = self.config.data.site_xpos[self.index.fingertip_sites[finger]].copy()
+        return tip
 
     def _set(self, arm_q: FloatArray, hand_q: FloatArray) -> None:
         q = self.config.q.copy()

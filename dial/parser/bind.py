@@ -58,8 +58,8 @@ def bind(instr: Instruction, defn: Definition) -> tuple[Bound, list[tuple[Span, 
     for p in defn.params:
         if p.key is None:
             continue
-        spec = None if instr.verbs else instr.spec(p.key)
-        if spec is None:
+        keyed = None if instr.verbs else instr.spec(p.key)
+        if keyed is None:
             names = [s.name for s in instr.params if not instr.verbs]
             close = get_close_matches(p.key, names, n=1)
             hint = f"; did you mean '{close[0]}'?" if close else ""
@@ -70,9 +70,9 @@ def bind(instr: Instruction, defn: Definition) -> tuple[Bound, list[tuple[Span, 
             errors.append((p.span, f"parameter '{p.key}' is given twice"))
             continue
         if len(p.words) != 1:
-            errors.append((p.span, f"'{p.key}' takes one value: expected {spec.type.expected}"))
+            errors.append((p.span, f"'{p.key}' takes one value: expected {keyed.type.expected}"))
             continue
-        args[p.key], spans[p.key] = _parse(spec, p.words[0], errors), p.words[0].span
+        args[p.key], spans[p.key] = _parse(keyed, p.words[0], errors), p.words[0].span
     for spec in specs if instr.verbs else instr.params:
         if spec.name in args:
             continue

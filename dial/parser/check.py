@@ -11,6 +11,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from difflib import get_close_matches
 from pathlib import Path
+from typing import Any
 
 from dial.errors import Diagnostic, ScriptError, Span
 from dial.instructions.catalogue import INSTRUCTIONS, Instruction
@@ -28,7 +29,7 @@ class EventDef:
 
     name: str
     instruction: Instruction
-    args: Mapping[str, object]
+    args: Mapping[str, Any]  # bound values, SI units
     effectors: frozenset[str]
     definition: Definition
 

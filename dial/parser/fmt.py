@@ -91,13 +91,14 @@ def format_text(text: str, path: str = "<script>") -> str:
         target = max(NAME.match(ln.code).end() for ln in execs) + 1  # type: ignore[union-attr]
         block: list[Line] = []
         rulers: list[Line] = []
-        for ln in [*lines, None]:
-            if ln is not None and ln.kind is Kind.COMMENT:
-                if _RULER.match(ln.text) and not ln.foreign:
-                    rulers.append(ln)
+        ends: list[Line | None] = [*lines, None]
+        for item in ends:
+            if item is not None and item.kind is Kind.COMMENT:
+                if _RULER.match(item.text) and not item.foreign:
+                    rulers.append(item)
                 continue
-            if ln is not None and ln.kind is Kind.EXECUTION:
-                block.append(ln)
+            if item is not None and item.kind is Kind.EXECUTION:
+                block.append(item)
                 continue
             if block:
                 _align(block, rulers, target, out)

@@ -41,7 +41,8 @@ def slerp(r0: FloatArray, r1: FloatArray, u: float) -> FloatArray:
     k = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
     a = angle * u
     step = np.eye(3) + np.sin(a) * k + (1.0 - np.cos(a)) * (k @ k)
-    return r0 @ step
+    out: FloatArray = r0 @ step
+    return out
 
 
 @dataclass(frozen=True)
@@ -146,8 +147,8 @@ class PumaCommand(ArmMotion):
         verb = self.arg("verb")
         if verb == "ex":
             name = self.arg("program")
-            for st in self.ctx.world.programs[name].statements:
-                planner.statement(st, f"program {name}, line {st.line}")
+            for stored in self.ctx.world.programs[name].statements:
+                planner.statement(stored, f"program {name}, line {stored.line}")
             return
         line = 1
         st: Statement

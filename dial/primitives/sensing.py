@@ -90,7 +90,8 @@ def taxel_points(ctx: Context, finger: int) -> FloatArray:
     adr, n = int(model.mesh_vertadr[mesh]), int(model.mesh_vertnum[mesh])
     local = model.mesh_vert[adr : adr + n].astype(np.float64)
     rot = data.geom_xmat[geom].reshape(3, 3)
-    return data.geom_xpos[geom] + local @ rot.T
+    points: FloatArray = data.geom_xpos[geom] + local @ rot.T
+    return points
 
 
 class RecordContact(InstantPrimitive):
