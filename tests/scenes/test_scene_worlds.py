@@ -13,7 +13,6 @@ from dial.instructions.scene_names import SceneNotFoundError
 from dial.scene import (
     Appro,
     Depart,
-    Drive,
     Move,
     PlaneFit,
     WorldFileError,
@@ -97,10 +96,11 @@ def test_values_are_converted_to_si() -> None:
     # Pitch 90 deg about y: w = x = cos 45 deg... as a quaternion (w, x, y, z).
     assert grasp.quat == pytest.approx((math.sqrt(0.5), 0, math.sqrt(0.5), 0))
     down = pour.locations["home"]
-    assert down.body is None and down.quat == pytest.approx((0, 1, 0, 0), abs=1e-12)
+    assert down.body is None and down.quat == pytest.approx((0, 0, 1, 0), abs=1e-12)
     program = pour.programs["pour"].statements
-    assert program[0] == Move(1, "pitcher_lift", straight=True)
-    assert program[2] == Drive(3, 6, pytest.approx(-math.radians(120)))  # type: ignore[arg-type]
+    assert program == (Move(1, "pour_over_cup", True), Move(2, "pitcher_set", True))
+    tipped = pour.locations["pour_over_cup"].rpy
+    assert tipped == pytest.approx(tuple(math.radians(a) for a in (-90, -30, -90)))
     assert load_world(worlds_dir() / "pour.toml").programs["get_top"].statements == (
         Appro(1, "lid_grasp", 0.10),
         Move(2, "lid_grasp", straight=True),
