@@ -85,8 +85,8 @@ def taxel_points(ctx: Context, finger: int) -> FloatArray:
     sensor = int(
         mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SENSOR, f"hand_{FINGERS[finger]}_tactile")
     )
-    geom = int(model.sensor_objid[sensor])
-    mesh = int(model.geom_dataid[geom])
+    # A tactile sensor's object is its mesh; its reference is the geom that carries it.
+    mesh, geom = int(model.sensor_objid[sensor]), int(model.sensor_refid[sensor])
     adr, n = int(model.mesh_vertadr[mesh]), int(model.mesh_vertnum[mesh])
     local = model.mesh_vert[adr : adr + n].astype(np.float64)
     rot = data.geom_xmat[geom].reshape(3, 3)
