@@ -11,7 +11,7 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, TextIO
+from typing import Any, Protocol, TextIO
 
 import mujoco
 import numpy as np
@@ -37,6 +37,32 @@ SETTLE_S = 0.5  # objects settle on the table before the script starts
 START = ((0.40, 0.0, 0.80), (np.pi, 0.0, 0.0))
 
 
+@dataclass(frozen=True)
+class Watched:
+    """What an observer may read, and never write: the robot, the scene's world, the log."""
+
+    robot: MujocoRobot
+    world: World
+    log: EventLog
+
+
+class Observer(Protocol):
+    """Watches a run without changing it: recording, video, viewers (dial.recording).
+
+    ``begin`` is called after the scene has settled, ``period`` after every control period with
+    the periods simulated so far and the current tick: an observer samples on those integers
+    (simulated time), never on wall time.
+    """
+
+    def begin(self, run: Watched) -> None: ...
+
+    def period(self, periods: int, tick: int) -> None: ...
+
+    def end(self, result: RunResult | None) -> None:
+        """After the criteria are measured; ``result`` is None after an interrupt or error."""
+        ...
+
+
 @dataclass
 class RunOptions:
     tick: float | None = None
@@ -46,6 +72,7 @@ class RunOptions:
     realtime: bool = False
     log: TextIO | None = None
     on_tick: Callable[[int, float, list[str]], None] | None = None
+    observers: list[Observer] = field(default_factory=list)
 
 
 @dataclass
@@ -74,9 +101,12 @@ def tick_length(script: Script, options: RunOptions) -> float:
 
 def _world(script: Script) -> World:
     scene = script.program.scene
-    if scene is None:
-        raise DialError(f"{script.path}: the script names no scene; add '@scene NAME' to run it")
-    return load_world(resolve_scene(scene.text, Path(script.path).resolve().parent))
+    text = script.scene_override or (scene.text if scene is not None else None)
+    if text is None:
+        raise DialError(
+            f"{script.path}: the script names no scene; add '@scene NAME' or run it with --scene"
+        )
+    return load_world(resolve_scene(text, Path(script.path).resolve().parent))
 
 
 def _scene_bodies(model: mujoco.MjModel, world: World) -> list[int]:
@@ -141,6 +171,18 @@ def prepare(script: Script, options: RunOptions, log: EventLog) -> tuple[MujocoR
     return robot, Context(robot, world, believed, ik)
 
 
+def _fan_out(observers: list[Observer]) -> Callable[[int, int], None] | None:
+    """One callback for the runner; None (no per-period cost) without observers."""
+    if len(observers) <= 1:
+        return observers[0].period if observers else None
+
+    def period(periods: int, tick: int) -> None:
+        for observer in observers:
+            observer.period(periods, tick)
+
+    return period
+
+
 def run(script: Script, options: RunOptions) -> RunResult:
     """Run ``script`` to the end (or its abort) and evaluate the scene's criteria."""
     log = EventLog(options.log)
@@ -148,7 +190,22 @@ def run(script: Script, options: RunOptions) -> RunResult:
     robot, ctx = prepare(script, options, log)
     if options.realtime:
         robot.pace = 1.0
-    runner = Runner(robot, make_factory(ctx), tick, log, on_tick=options.on_tick)
+    begun: list[Observer] = []
+    result: RunResult | None = None
+    try:  # observers end also on an interrupt or an error: a recording keeps what was seen
+        for observer in options.observers:
+            observer.begin(Watched(robot, ctx.world, log))
+            begun.append(observer)
+        factory = make_factory(ctx)
+        runner = Runner(robot, factory, tick, log, on_tick=options.on_tick, observe=_fan_out(begun))
+        result = _run(script, runner, robot, ctx)
+        return result
+    finally:
+        for observer in begun:
+            observer.end(result)
+
+
+def _run(script: Script, runner: Runner, robot: MujocoRobot, ctx: Context) -> RunResult:
     start = time.perf_counter()
     summary = trio.run(runner.run, script)
     wall = time.perf_counter() - start
@@ -166,6 +223,6 @@ def run(script: Script, options: RunOptions) -> RunResult:
         dict(ctx.results),
         wall,
         robot.steps,
-        log,
+        runner.log,
         [float(x) for x in robot.data.qpos],
     )

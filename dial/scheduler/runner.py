@@ -88,6 +88,7 @@ class Runner:
         log: EventLog | None = None,
         abort_on: frozenset[Outcome] = ABORT_ON,
         on_tick: Callable[[int, float, list[str]], None] | None = None,
+        observe: Callable[[int, int], None] | None = None,
     ) -> None:
         self.robot = robot
         self.factory = factory
@@ -96,6 +97,8 @@ class Runner:
         self.log = log or EventLog()
         self.abort_on = abort_on
         self.on_tick = on_tick  # progress display: (tick, sim time, running events)
+        # Read-only watchers (recording, video, viewers): (periods so far, tick), after each period.
+        self.observe = observe
         self.periods = 0  # simulated control periods so far
         self.clock = 0  # tick time, in periods: stands still while a tick is stretched
         self.tick = 0  # absolute ticks started so far
@@ -315,6 +318,8 @@ class Runner:
                 self._end(a, ended, t_end)
         fault = await self.robot.advance()
         self.periods += 1
+        if self.observe is not None:
+            self.observe(self.periods, self.tick)
         await self._reap()
         if fault is not None and self._abort is None:
             running = ", ".join(a.info.event.name for a in self.active) or "no event"

@@ -1,0 +1,151 @@
+"""What a recording draws, read from the MuJoCo model: bodies and their visible geoms.
+
+Pure MuJoCo and numpy; the rerun calls live in :mod:`dial.recording.rerun_sink`.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from dial.backend.snapshot import FloatArray
+
+SHOWN_GROUPS = 4  # geom groups 0-3 are drawn; 4 and up hold debug sites and markers
+KINDS = {
+    mujoco.mjtGeom.mjGEOM_SPHERE: "sphere",
+    mujoco.mjtGeom.mjGEOM_CAPSULE: "capsule",
+    mujoco.mjtGeom.mjGEOM_ELLIPSOID: "ellipsoid",
+    mujoco.mjtGeom.mjGEOM_CYLINDER: "cylinder",
+    mujoco.mjtGeom.mjGEOM_BOX: "box",
+    mujoco.mjtGeom.mjGEOM_MESH: "mesh",
+}  # planes (the floor) are left to the viewer's ground grid
+
+
+@dataclass(frozen=True)
+class Camera:
+    """A fixed camera in MuJoCo's free-camera terms: ``lookat`` (3,) m, ``distance`` m,
+    ``azimuth`` and ``elevation`` deg (negative looks down)."""
+
+    lookat: tuple[float, float, float]
+    distance: float
+    azimuth: float
+    elevation: float
+
+    def position(self) -> tuple[float, float, float]:
+        """Where the camera sits, in the world frame (m)."""
+        az, el = np.radians(self.azimuth), np.radians(self.elevation)
+        forward = np.array([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)])
+        x, y, z = np.asarray(self.lookat) - self.distance * forward
+        return (float(x), float(y), float(z))
+
+
+def task_camera(data: mujoco.MjData, objects: list[int]) -> Camera:
+    """A camera on the task: the table's front edge below, the objects in the middle, the arm
+    behind them on the left, slightly from the side so that a pour or a twist shows.
+
+    It looks at a point 0.2 m above the objects' centroid, a little towards the arm's base
+    (the world origin), so that the hand stays in view as it works on them.
+    """
+    centre = data.xpos[objects].mean(axis=0) if objects else np.array([0.5, 0.0, 0.35])
+    lookat = (0.9 * float(centre[0]), float(centre[1]), float(centre[2]) + 0.2)
+    return Camera(lookat, distance=1.1, azimuth=165.0, elevation=-18.0)
+
+
+@dataclass(frozen=True, eq=False)
+class Shape:
+    """One visible geom, in its body's frame.
+
+    ``size`` is MuJoCo's geom size (3,) m; ``pos`` (3,) m and ``quat`` (4,) (w, x, y, z) place
+    it in the body; ``rgba`` (4,) in [0, 1]. Meshes carry ``vertices`` (V, 3) m in the geom
+    frame and ``faces`` (F, 3) vertex indices.
+    """
+
+    body: int
+    name: str
+    kind: str
+    size: FloatArray
+    pos: FloatArray
+    quat: FloatArray
+    rgba: FloatArray
+    vertices: FloatArray | None = None
+    faces: np.ndarray | None = None
+
+
+def entity_names(model: mujoco.MjModel, obj: mujoco.mjtObj, count: int, prefix: str) -> list[str]:
+    """Names usable as entity path parts: the model's name, or ``prefix<id>`` when unnamed."""
+    names = []
+    for i in range(count):
+        name = mujoco.mj_id2name(model, obj, i) or f"{prefix}{i}"
+        names.append(re.sub(r"[^A-Za-z0-9_.-]", "_", name))
+    return names
+
+
+def body_names(model: mujoco.MjModel) -> list[str]:
+    return entity_names(model, mujoco.mjtObj.mjOBJ_BODY, model.nbody, "body")
+
+
+def moving_bodies(model: mujoco.MjModel) -> np.ndarray:
+    """Ids of the bodies that can move: those not welded to the world (the arm, hand, objects)."""
+    return np.flatnonzero(model.body_weldid != 0)
+
+
+def shapes(model: mujoco.MjModel) -> list[Shape]:
+    """Every geom in groups 0-3 with a drawable type and a visible colour, in geom order."""
+    names = entity_names(model, mujoco.mjtObj.mjOBJ_GEOM, model.ngeom, "geom")
+    out = []
+    for g in range(model.ngeom):
+        kind = KINDS.get(mujoco.mjtGeom(int(model.geom_type[g])))
+        mat = int(model.geom_matid[g])
+        rgba = model.mat_rgba[mat] if mat >= 0 else model.geom_rgba[g]
+        if kind is None or model.geom_group[g] >= SHOWN_GROUPS or rgba[3] <= 0.0:
+            continue
+        vertices = faces = None
+        if kind == "mesh":
+            mesh = int(model.geom_dataid[g])
+            v0, nv = int(model.mesh_vertadr[mesh]), int(model.mesh_vertnum[mesh])
+            f0, nf = int(model.mesh_faceadr[mesh]), int(model.mesh_facenum[mesh])
+            vertices = model.mesh_vert[v0 : v0 + nv].astype(np.float64)
+            faces = model.mesh_face[f0 : f0 + nf].copy()
+        out.append(
+            Shape(
+                body=int(model.geom_bodyid[g]),
+                name=names[g],
+                kind=kind,
+                size=model.geom_size[g].copy(),
+                pos=model.geom_pos[g].copy(),
+                quat=model.geom_quat[g].copy(),
+                rgba=np.asarray(rgba, dtype=np.float64).copy(),
+                vertices=vertices,
+                faces=faces,
+            )
+        )
+    return out
+
+
+def superquadric_mesh(
+    size: FloatArray, shape: FloatArray, n: int = 24
+) -> tuple[FloatArray, np.ndarray]:
+    """A superquadric's surface in its own frame: vertices (V, 3) m and faces (F, 3).
+
+    ``size`` (3,) half-sizes, ``shape`` (eps1, eps2) as in :mod:`dial.haptics.fit`.
+    """
+
+    def power(x: FloatArray, e: float) -> FloatArray:
+        return np.asarray(np.sign(x) * np.abs(x) ** e)
+
+    eta = np.linspace(-np.pi / 2, np.pi / 2, n + 1)[:, None]  # latitude, rows
+    omega = np.linspace(-np.pi, np.pi, 2 * n + 1)[None, :]  # longitude, columns
+    e1, e2 = float(shape[0]), float(shape[1])
+    x = size[0] * power(np.cos(eta), e1) * power(np.cos(omega), e2)
+    y = size[1] * power(np.cos(eta), e1) * power(np.sin(omega), e2)
+    z = size[2] * power(np.sin(eta), e1) * np.ones_like(omega)
+    vertices = np.stack([x, y, z], axis=-1).reshape(-1, 3)
+    cols = 2 * n + 1
+    r, c = np.meshgrid(np.arange(n), np.arange(2 * n), indexing="ij")
+    a = (r * cols + c).ravel()
+    b, d, e = a + 1, a + cols, a + cols + 1
+    faces = np.concatenate([np.stack([a, b, e], 1), np.stack([a, e, d], 1)])
+    return vertices, faces

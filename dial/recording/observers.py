@@ -1,0 +1,117 @@
+"""Observers of a run (see :class:`dial.engine.Observer`): the rerun recorder and the state log.
+
+They sample on whole numbers of control periods, so a frame's time is exact simulated time
+and the same run gives the same frames.
+"""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+
+from dial.backend.driver import MujocoRobot
+from dial.engine import RunResult, Watched
+from dial.recording.frames import RECORD_HZ, Frames, every
+from dial.recording.geometry import task_camera
+from dial.recording.rerun_sink import RerunSink
+from dial.scheduler.log import EventLog
+
+STATE_HZ = 25.0  # state records per second of simulated time (--log-states)
+STATE_DIGITS = 4  # 0.1 mm and 0.1 mrad: plenty to draw, and a third shorter than the default
+TENSION_DIGITS = 2  # 0.01 N
+
+
+def object_bodies(model: mujoco.MjModel, bodies: list[str]) -> list[int]:
+    return [int(mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, b)) for b in bodies]
+
+
+class Recorder:
+    """Records a run into a :class:`RerunSink`: frames at ``rate_hz``, every log record."""
+
+    def __init__(self, sink: RerunSink, title: str, rate_hz: float = RECORD_HZ) -> None:
+        self.sink, self.title, self.rate_hz = sink, title, rate_hz
+        self._seen = 0  # log records already sent
+        self._tick = 0
+
+    def begin(self, run: Watched) -> None:
+        self.robot, self.log = run.robot, run.log
+        model, data = run.robot.model, run.robot.data
+        self.frames = Frames(model)
+        self.every = every(self.rate_hz, run.robot.period)
+        camera = task_camera(data, object_bodies(model, list(run.world.objects.values())))
+        self.sink.scene(model, data, self.title, camera)
+        self._capture(0, 0)
+
+    def period(self, periods: int, tick: int) -> None:
+        if periods % self.every == 0:
+            self._capture(periods, tick)
+
+    def _capture(self, periods: int, tick: int) -> None:
+        self._tick = tick
+        self._drain()
+        self.frames.capture(periods * self.robot.period, tick, self.robot.data)
+        if len(self.frames) >= self.sink.batch:
+            self._send()
+
+    def _drain(self) -> None:
+        records = self.log.records
+        if self._seen == len(records):
+            return
+        tips = self.robot.data.site_xpos[self.robot.index.fingertip_sites]
+        for record in records[self._seen :]:
+            self.sink.record(record, self._tick, tips)
+        self._seen = len(records)
+
+    def _send(self) -> None:
+        batch = self.frames.take()
+        if batch is not None:
+            self.sink.frames(batch)
+
+    def end(self, result: RunResult | None) -> None:
+        self._drain()
+        self._send()
+        if result is not None:
+            summary = {
+                "kind": "summary",
+                "ok": result.ok,
+                "success": result.success,
+                "criteria": result.details,
+                "sim_time": result.summary.sim_time,
+            }
+            self.sink.record(summary, self._tick, None)
+        self.sink.close()
+
+
+class StateLog:
+    """Writes ``state`` records into the log at ``rate_hz`` (``--log-states``), for replay.
+
+    The one observer that writes: it adds records to the log, and only when asked.
+    A record holds ``t``, ``tick``, the whole ``qpos`` (the arm, the hand, and every free
+    object) and the 32 tendon ``tension``s, which cannot be recomputed from positions.
+    """
+
+    def __init__(self, rate_hz: float = STATE_HZ) -> None:
+        self.rate_hz = rate_hz
+
+    def begin(self, run: Watched) -> None:
+        self.robot: MujocoRobot = run.robot
+        self.log: EventLog = run.log
+        self.every = every(self.rate_hz, run.robot.period)
+        self._write(0, 0)
+
+    def period(self, periods: int, tick: int) -> None:
+        if periods % self.every == 0:
+            self._write(periods, tick)
+
+    def _write(self, periods: int, tick: int) -> None:
+        d, ix = self.robot.data, self.robot.index
+        self.log.write(
+            "state",
+            tick=tick,
+            t=periods * self.robot.period,
+            qpos=np.round(d.qpos, STATE_DIGITS),
+            tension=np.round(d.sensordata[ix.tension_sensors], TENSION_DIGITS),
+        )
+
+    def end(self, result: RunResult | None) -> None:
+        """Nothing to close: the log belongs to the run."""

@@ -1,0 +1,88 @@
+"""``dial replay LOG --record OUT.rrd``: a recording rebuilt from a log's ``state`` records.
+
+A state (written with ``dial run --log FILE --log-states``) holds the whole ``qpos`` and the
+32 tendon tensions. Positions give everything else: body poses by forward kinematics, and
+the tactile images, which are penetration depths. The scene comes from the log's ``scene``
+record (its name, and the perturbation of the fixed objects; free objects are in ``qpos``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import mujoco
+import numpy as np
+
+from dial.backend.model import load_model
+from dial.errors import DialError
+from dial.recording.frames import Frames
+from dial.recording.geometry import task_camera
+from dial.recording.observers import object_bodies
+from dial.recording.rerun_sink import RerunSink
+from dial.scene.resolve import resolve_scene
+from dial.scene.world import load_world
+
+
+def rebuild(records: Sequence[dict[str, Any]], out: Path, title: str, base: Path) -> int:
+    """Write the run in ``records`` as a recording to ``out``; returns the number of frames.
+
+    ``base`` is where a scene given as a relative path resolves (the log's directory).
+    """
+    states = [r for r in records if r["kind"] == "state"]
+    if not states:
+        raise DialError(
+            "the log holds no 'state' records to rebuild a recording from; "
+            "run the script with --log FILE.jsonl --log-states"
+        )
+    scene = records[0]
+    world = load_world(resolve_scene(str(scene["scene"]), base))
+    model = load_model(world.model_path)
+    data = mujoco.MjData(model)
+    for name in world.objects.values():  # --perturb moved the fixed objects in the model
+        body = model.body(name).id
+        if model.body_parentid[body] == 0 and model.body_jntnum[body] == 0:
+            model.body_pos[body] += scene.get("perturb", [0.0, 0.0, 0.0])
+    if len(states[0]["qpos"]) != model.nq:
+        raise DialError(
+            f"the log's states hold {len(states[0]['qpos'])} positions, but scene "
+            f"'{world.name}' has {model.nq}: it has changed since the run"
+        )
+    data.qpos[:] = states[0]["qpos"]
+    mujoco.mj_forward(model, data)
+    sink = RerunSink(out)
+    try:
+        _send(records, model, data, sink, title, list(world.objects.values()))
+    finally:
+        sink.close()
+    return len(states)
+
+
+def _send(
+    records: Sequence[dict[str, Any]],
+    model: mujoco.MjModel,
+    data: mujoco.MjData,
+    sink: RerunSink,
+    title: str,
+    objects: list[str],
+) -> None:
+    sink.scene(model, data, title, task_camera(data, object_bodies(model, objects)))
+    frames = Frames(model)
+    tips = frames.index.fingertip_sites
+    tick = 0
+    for record in records:
+        if record["kind"] != "state":
+            sink.record(record, tick, data.site_xpos[tips])
+            continue
+        tick = int(record["tick"])
+        data.qpos[:] = record["qpos"]
+        mujoco.mj_forward(model, data)
+        frames.capture(float(record["t"]), tick, data, np.asarray(record["tension"]))
+        if len(frames) >= sink.batch:
+            batch = frames.take()
+            assert batch is not None
+            sink.frames(batch)
+    batch = frames.take()
+    if batch is not None:
+        sink.frames(batch)

@@ -1,0 +1,109 @@
+"""A run's timeline as text, from its log records: for ``dial replay`` and the recording's log.
+
+Pure functions of the records (JSON objects of ``--log``); no MuJoCo, no rerun.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Iterable, Mapping
+from pathlib import Path
+from typing import Any
+
+from dial.errors import DialError
+
+Record = Mapping[str, Any]
+BAD_OUTCOMES = {"missed": "warn", "timeout": "error", "error": "error"}
+
+
+def read_log(path: Path) -> list[dict[str, Any]]:
+    """The records of a ``--log`` file; a torn last line (a crash mid-write) is dropped."""
+    try:
+        lines = path.read_text(encoding="utf-8").splitlines()
+    except OSError as e:
+        raise DialError(f"cannot read the log '{path}': {e.strerror}") from e
+    records = []
+    for n, line in enumerate(lines, 1):
+        try:
+            record = json.loads(line)
+        except json.JSONDecodeError as e:
+            if n == len(lines):
+                break
+            raise DialError(f"{path}:{n}: not a JSON log record ({e.msg})") from e
+        if not isinstance(record, dict) or "kind" not in record:
+            raise DialError(f"{path}:{n}: not a dial log record (no 'kind')")
+        records.append(record)
+    if not records or records[0]["kind"] != "scene":
+        raise DialError(f"{path}: not a dial run log (it must start with a 'scene' record)")
+    return records
+
+
+def when(record: Record, tick: int) -> tuple[float, int]:
+    """A record's simulated time (s) and tick; ``tick`` (the latest seen) if it has none.
+
+    (A ``summary`` holds the run's end time and the tick *length*, not a tick.)
+    """
+    if record["kind"] == "summary":
+        return float(record.get("sim_time", 0.0)), tick
+    t = record.get("t", record.get("t1", 0.0))
+    return float(t), int(record.get("tick", tick))
+
+
+def describe(record: Record) -> tuple[str, str] | None:
+    """A record as one line of text and a level (info, warn, error); None for bookkeeping."""
+    kind = record["kind"]
+    if kind == "scene":
+        mm = 1000.0 * math.hypot(*record.get("perturb", [0.0]))
+        return (
+            f"scene {record['scene']} ({record.get('world', '?')}), seed {record.get('seed')}, "
+            f"objects perturbed {mm:.1f} mm",
+            "info",
+        )
+    if kind == "start":
+        return f"start {record['event']} (line {record['line']})", "info"
+    if kind == "end":
+        outcome = record["outcome"]
+        note = f": {record['message']}" if record.get("message") else ""
+        return f"end   {record['event']} {outcome}{note}", BAD_OUTCOMES.get(outcome, "info")
+    if kind == "tick":
+        if not record.get("stretch"):
+            return None
+        return f"tick {record['tick']} stretched by {record['stretch']} control periods", "info"
+    if kind == "condition":
+        return f"condition {record['condition']} is {str(record['value']).lower()}", "info"
+    if kind == "call":
+        return f"call {record['script']}", "info"
+    if kind == "contact":
+        return (
+            f"contact: {record['sensor']} on the {record['finger']} stopped the "
+            f"{record['effector']} ({record['value']:g})",
+            "info",
+        )
+    if kind == "thread":
+        return f"thread {record['name']} released", "info"
+    if kind in ("warning", "error"):
+        return str(record["message"]), "warn" if kind == "warning" else "error"
+    if kind == "interrupted":
+        return "interrupted; every effector holds its pose", "error"
+    if kind == "summary":
+        criteria = record.get("criteria", {})
+        marks = "; ".join(
+            f"[{'x' if ok else ' '}] {name}: {criteria.get(name, '')}"
+            for name, ok in record.get("success", {}).items()
+        )
+        verdict = "OK" if record.get("ok") else "FAILED"
+        return f"{verdict} {marks}".rstrip(), "info" if record.get("ok") else "error"
+    return None
+
+
+def timeline(records: Iterable[Record]) -> str:
+    """The run's timeline: one line per event start, end, contact, condition and message."""
+    lines = [f"{'tick':>5}  {'t (s)':>8}  what"]
+    tick = 0
+    for record in records:
+        t, tick = when(record, tick)
+        described = describe(record)
+        if described is not None:
+            lines.append(f"{tick:5d}  {t:8.3f}  {described[0]}")
+    return "\n".join(lines) + "\n"
