@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 from collections.abc import Callable, Sequence
 from pathlib import Path
@@ -41,8 +42,25 @@ def _scene_loader() -> SceneLoader:
     return load_scene_names
 
 
-def _load(arg: str) -> Script:
-    return load(resolve_script(arg), _scene_loader())
+def _load(arg: str, scene: str | None = None) -> Script:
+    return load(resolve_script(arg), _scene_loader(), scene=scene)
+
+
+def _scene_option(arg: str | None) -> str | None:
+    """``--scene``, resolved like ``@scene``: an existing file (from here) or a bundled name."""
+    if arg is None:
+        return None
+    from dial.scene import bundled_scene_names
+
+    if Path(arg).is_file():  # absolute, so that it means the same from every called script
+        return str(Path(arg).resolve())
+    names = bundled_scene_names()
+    if arg not in names:
+        raise UsageError(
+            f"--scene: '{arg}' is neither a file nor a bundled scene; "
+            f"bundled scenes: {', '.join(names)}"
+        )
+    return arg
 
 
 def cmd_check(args: argparse.Namespace) -> int:
@@ -98,11 +116,53 @@ def _progress(quiet: bool) -> Callable[[int, float, list[str]], None] | None:
     return show
 
 
+def _check_watching(args: argparse.Namespace) -> None:
+    """Usage errors (exit 2) and a missing display (exit 1), before the run starts."""
+    if args.log_states and not args.log:
+        raise UsageError("--log-states writes into the log: give --log FILE.jsonl too")
+    if args.record and Path(args.record).suffix.lower() != ".rrd":
+        raise UsageError(f"--record writes a .rrd file, not '{args.record}'")
+    if args.video:
+        if sys.platform.startswith("linux"):  # offscreen on the CPU; must precede `import mujoco`
+            os.environ.setdefault("MUJOCO_GL", "egl")
+        from dial.recording.video import video_problem
+
+        problem = video_problem(args.video)
+        if problem is not None:
+            raise UsageError(problem)
+    if args.rerun or args.viewer:
+        from dial.recording.viewer import require_display
+
+        require_display("--rerun" if args.rerun else "--viewer")
+
+
+def _watchers(args: argparse.Namespace, script: Script) -> list[Any]:
+    """The run's observers: state log, rerun recording or stream, video, viewer."""
+    watchers: list[Any] = []
+    if args.log_states:
+        from dial.recording.observers import StateLog
+
+        watchers.append(StateLog())
+    if args.record or args.rerun:
+        from dial.recording.observers import Recorder
+        from dial.recording.rerun_sink import RerunSink
+
+        sink = RerunSink(Path(args.record) if args.record else None, spawn=args.rerun)
+        watchers.append(Recorder(sink, Path(script.path).name))
+    if args.video:
+        from dial.recording.video import VideoWriter
+
+        watchers.append(VideoWriter(Path(args.video)))
+    if args.viewer:
+        from dial.recording.viewer import PassiveViewer
+
+        watchers.append(PassiveViewer())
+    return watchers
+
+
 def cmd_run(args: argparse.Namespace) -> int:
-    for flag in ("record", "video", "rerun", "viewer"):
-        if getattr(args, flag):
-            raise UsageError(f"--{flag} is reserved for the recording work and not available yet")
-    script = _load(args.script)
+    _check_watching(args)
+    script = _load(args.script, _scene_option(args.scene))
     from dial.engine import RunOptions, run, tick_length
 
     log_file = open(args.log, "w", encoding="utf-8") if args.log else None  # noqa: SIM115
@@ -111,9 +171,10 @@ def cmd_run(args: argparse.Namespace) -> int:
         speed=args.speed,
         seed=args.seed,
         perturb_mm=args.perturb,
-        realtime=args.realtime,
+        realtime=args.realtime or args.viewer,
         log=log_file,
         on_tick=_progress(args.quiet),
+        observers=_watchers(args, script),
     )
     tick = tick_length(script, options)
     try:
@@ -168,6 +229,50 @@ def _print_summary(result: Any, tick: float) -> None:
     print("OK" if result.ok else "FAILED")
 
 
+def cmd_replay(args: argparse.Namespace) -> int:
+    from dial.recording.timeline import read_log, timeline
+
+    path = Path(args.log)
+    records = read_log(path)
+    if args.record:
+        if Path(args.record).suffix.lower() != ".rrd":
+            raise UsageError(f"--record writes a .rrd file, not '{args.record}'")
+        from dial.recording.replay import rebuild
+
+        frames = rebuild(records, Path(args.record), f"{path.name} (replay)", path.parent)
+        print(f"{args.record}: {frames} frames rebuilt from {path}", file=sys.stderr)
+    sys.stdout.write(timeline(records))
+    return 0
+
+
+def cmd_tune(args: argparse.Namespace) -> int:
+    import math
+
+    from dial.tune import ProcessExecutor, TuneOptions, parse_ticks, tune
+
+    try:
+        ticks = parse_ticks(args.ticks)
+    except ValueError as e:
+        raise UsageError(f"--ticks: {e}") from None
+    for flag, value in (("--trials", args.trials), ("--jobs", args.jobs)):
+        if value is not None and value < 1:
+            raise UsageError(f"{flag} must be at least 1, got {value}")
+    if args.seed < 0:
+        raise UsageError(f"--seed must be 0 or more, got {args.seed}")
+    if not (math.isfinite(args.perturb) and args.perturb >= 0):
+        raise UsageError(f"--perturb must be 0 mm or more, got {args.perturb:g}")
+    options = TuneOptions(
+        script=args.script,
+        ticks=ticks,
+        trials=args.trials,
+        perturb_mm=args.perturb,
+        seed=args.seed,
+        plot=Path(args.plot) if args.plot else None,
+        json=args.json,
+    )
+    return tune(options, ProcessExecutor(args.jobs))
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="dial",
@@ -188,6 +293,12 @@ def build_parser() -> argparse.ArgumentParser:
         "error or a failed criterion, 130 on interrupt.",
     )
     p.add_argument("script", metavar="SCRIPT", help="script path or bundled name")
+    p.add_argument(
+        "--scene",
+        metavar="NAME_OR_PATH",
+        help="run in this scene instead of the script's @scene (also for the scripts it "
+        "@calls): a world file path, else a bundled scene name",
+    )
     p.add_argument("--tick", type=float, metavar="S", help="tick length in s (default: @tick)")
     p.add_argument("--speed", type=float, default=1.0, metavar="F", help="divide the tick by F")
     p.add_argument("--seed", type=int, default=0, metavar="N", help="seed for --perturb")
@@ -202,14 +313,41 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true", help="print a JSON summary as the last line")
     p.add_argument("--quiet", action="store_true", help="no progress and no summary table")
     p.add_argument("--realtime", action="store_true", help="pace the run to wall-clock time")
-    for flag, what in (
-        ("--record", "FILE.rrd"),
-        ("--video", "FILE.mp4"),
-    ):
-        p.add_argument(flag, metavar=what, help="reserved: comes with the recording work")
-    p.add_argument("--rerun", action="store_true", help="reserved: comes with the recording work")
-    p.add_argument("--viewer", action="store_true", help="reserved: comes with the recording work")
+    p.add_argument(
+        "--log-states",
+        action="store_true",
+        help="also log the robot's and objects' state 25 times per simulated second, "
+        "for 'dial replay --record'",
+    )
+    p.add_argument(
+        "--record",
+        metavar="FILE.rrd",
+        help="write a rerun recording: geometry, body poses, joints, tendons, tactile "
+        "images, event lanes (open with 'rerun FILE.rrd'; see docs/recording.md)",
+    )
+    p.add_argument(
+        "--video",
+        metavar="FILE.mp4",
+        help="render the run offscreen to an .mp4 or .gif at 25 frames per simulated "
+        "second (needs the 'video' extra)",
+    )
+    p.add_argument(
+        "--rerun", action="store_true", help="stream the recording to a spawned rerun viewer"
+    )
+    p.add_argument("--viewer", action="store_true", help="watch in MuJoCo's viewer, in real time")
     p.set_defaults(func=cmd_run)
+
+    p = sub.add_parser(
+        "replay",
+        help="print a run's timeline from its log, or rebuild its recording",
+        description="Print the timeline of a run from its --log: each event's start and end "
+        "with tick, simulated time and outcome, contacts, conditions, messages and the "
+        "criteria. With --record, also rebuild a rerun recording from the log's states "
+        "(written by 'dial run --log FILE --log-states').",
+    )
+    p.add_argument("log", metavar="LOG.jsonl", help="a log written by 'dial run --log'")
+    p.add_argument("--record", metavar="FILE.rrd", help="rebuild a rerun recording")
+    p.set_defaults(func=cmd_replay)
 
     p = sub.add_parser(
         "check",
@@ -242,6 +380,35 @@ def build_parser() -> argparse.ArgumentParser:
         "--check", action="store_true", help="change nothing; exit 1 if a file would change"
     )
     p.set_defaults(func=cmd_fmt)
+
+    p = sub.add_parser(
+        "tune",
+        help="run a script over a grid of tick lengths and find the fastest reliable one",
+        description="Run the script K times at each of N tick lengths from A to B, in "
+        "parallel worker processes, and print success rate and task time per tick length. "
+        "Exit 0 when some tick length succeeded in every trial, 1 when none did (or the "
+        "plot could not be written), 2 on a usage error. See docs/tuning.md.",
+    )
+    p.add_argument("script", metavar="SCRIPT", help="script path or bundled name")
+    p.add_argument(
+        "--ticks",
+        required=True,
+        metavar="A:B:N",
+        help="N tick lengths from A to B s inclusive, linearly spaced (e.g. 0.05:0.5:10)",
+    )
+    p.add_argument("--trials", type=int, default=1, metavar="K", help="trials per tick length")
+    p.add_argument(
+        "--perturb",
+        type=float,
+        default=0.0,
+        metavar="MM",
+        help="displace the objects by MM in a direction seeded per trial",
+    )
+    p.add_argument("--seed", type=int, default=0, metavar="S", help="seed of the trial seeds")
+    p.add_argument("--jobs", type=int, metavar="J", help="worker processes (default: all cores)")
+    p.add_argument("--plot", metavar="FILE.png", help="plot success rate and task time")
+    p.add_argument("--json", action="store_true", help="print the table as JSON, last line")
+    p.set_defaults(func=cmd_tune)
     return parser
 
 

@@ -44,6 +44,9 @@ class Script:
     condition_only: frozenset[str]
     timeline: tuple[Step, ...]
     scene: SceneNames | None
+    # ``dial run --scene``: the scene that replaces ``@scene`` here and in every called script
+    # (an absolute path or a bundled name), or None to use ``@scene``.
+    scene_override: str | None = None
 
     @property
     def tick(self) -> float | None:
@@ -68,8 +71,10 @@ class _Checker:
         stack: tuple[str, ...],
         diags: list[Diagnostic],
         origin: Path,
+        scene_override: str | None,
     ) -> None:
         self.program = program
+        self.scene_override = scene_override
         self.origin = origin  # the real file, for resolving @call and @scene paths
         self.lines = source.split("\n")
         self.loader = loader
@@ -93,19 +98,28 @@ class _Checker:
         )
         timeline = self.compile(self.program.body, shown)
         return Script(
-            self.program.path, self.program, self.events, condition_only, timeline, self.scene
+            self.program.path,
+            self.program,
+            self.events,
+            condition_only,
+            timeline,
+            self.scene,
+            self.scene_override,
         )
 
     def load_scene(self) -> None:
         setting = self.program.scene
-        if setting is None or self.loader is None:
+        text = self.scene_override or (setting.text if setting is not None else None)
+        if text is None or self.loader is None:
             return
+        # An overriding scene has no place in the script: its problems point at line 1.
+        span = setting.span if setting is not None and not self.scene_override else Span.at(1, 1)
         try:
-            self.scene = self.loader(setting.text, self.origin.parent)
+            self.scene = self.loader(text, self.origin.parent)
         except SceneNotFoundError as e:
-            self.error(setting.span, str(e))
+            self.error(span, str(e))
         except ValueError as e:
-            self.error(setting.span, f"scene '{setting.text}' has a bad world file: {e}")
+            self.error(span, f"scene '{text}' has a bad world file: {e}")
 
     def define(self, d: Definition) -> None:
         if d.broken:  # its syntax error is reported already
@@ -283,11 +297,14 @@ class _Checker:
             return None
         before = len(self.diags)
         display = str(Path(self.program.path).parent / stmt.target)
-        callee = check_file(target, self.loader, self.stack, self.diags, display)
+        callee = check_file(
+            target, self.loader, self.stack, self.diags, display, self.scene_override
+        )
         if callee is None or len(self.diags) > before:
             return None
         mine, theirs = self.program.scene, callee.program.scene
-        if mine is not None and theirs is not None and mine.text != theirs.text:
+        overridden = self.scene_override is not None  # every script runs in the chosen scene
+        if not overridden and mine is not None and theirs is not None and mine.text != theirs.text:
             self.error(
                 stmt.span,
                 f"called script '{stmt.target}' needs scene '{theirs.text}' "
@@ -304,11 +321,13 @@ def check_text(
     stack: tuple[str, ...] = (),
     diags: list[Diagnostic] | None = None,
     origin: Path | None = None,
+    scene: str | None = None,
 ) -> Script | None:
     """Parse and check ``text``; append problems to ``diags`` (raise if ``diags`` is None).
 
     ``path`` is how messages name the file; ``origin`` is the real file that
-    ``@call`` and ``@scene`` paths are relative to (default: ``path``).
+    ``@call`` and ``@scene`` paths are relative to (default: ``path``). ``scene``, if
+    given, replaces the ``@scene`` of this script and of every script it calls.
     """
     own = diags is None
     sink: list[Diagnostic] = [] if diags is None else diags
@@ -316,7 +335,7 @@ def check_text(
     sink.extend(syntax)
     origin = Path(path) if origin is None else origin
     resolved = str(origin.resolve())
-    script = _Checker(program, text, loader, (*stack, resolved), sink, origin).run()
+    script = _Checker(program, text, loader, (*stack, resolved), sink, origin, scene).run()
     if own and sink:
         raise ScriptError(sink)
     return script
@@ -328,16 +347,26 @@ def check_file(
     stack: tuple[str, ...] = (),
     diags: list[Diagnostic] | None = None,
     display: str | None = None,
+    scene: str | None = None,
 ) -> Script | None:
     """Read, parse and check the script at ``path`` (``display`` is how errors name it)."""
     text = Path(path).read_text(encoding="utf-8", errors="replace")
-    return check_text(text, display or str(path), loader, stack, diags, Path(path))
+    return check_text(text, display or str(path), loader, stack, diags, Path(path), scene)
 
 
-def load(path: str | Path, loader: SceneLoader | None = None, display: str | None = None) -> Script:
-    """Parse and check a script file; raise :class:`ScriptError` listing every problem."""
+def load(
+    path: str | Path,
+    loader: SceneLoader | None = None,
+    display: str | None = None,
+    scene: str | None = None,
+) -> Script:
+    """Parse and check a script file; raise :class:`ScriptError` listing every problem.
+
+    ``scene`` (a path or a bundled scene name) replaces the script's ``@scene``, and that of
+    every script it calls.
+    """
     diags: list[Diagnostic] = []
-    script = check_file(Path(path), loader, (), diags, display)
+    script = check_file(Path(path), loader, (), diags, display, scene)
     if diags:
         raise ScriptError(diags)
     assert script is not None

@@ -1,0 +1,48 @@
+"""Tick-speed tuning: run a script over a grid of tick lengths and trials (``dial tune``).
+
+The layers: :mod:`~dial.tune.grid` plans the trials, :mod:`~dial.tune.trial`
+runs one on a backend (the engine, or a fake robot in tests),
+:mod:`~dial.tune.executor` maps them over worker processes (the seam for a
+distributed executor), and :mod:`~dial.tune.report` turns the results into the
+table, the verdict and the JSON object.
+"""
+
+from dial.tune.command import TuneOptions, tune
+from dial.tune.executor import Executor, ProcessExecutor, Progress, SerialExecutor
+from dial.tune.grid import Trial, parse_ticks, plan, trial_seed
+from dial.tune.report import TickRow, fastest_reliable, render_table, summarise, to_json, verdict
+from dial.tune.trial import (
+    Backend,
+    RunReport,
+    TrialResult,
+    engine_backend,
+    failed_trial,
+    run_trial,
+    sweep,
+)
+
+__all__ = [
+    "Backend",
+    "Executor",
+    "ProcessExecutor",
+    "Progress",
+    "RunReport",
+    "SerialExecutor",
+    "TickRow",
+    "Trial",
+    "TrialResult",
+    "TuneOptions",
+    "engine_backend",
+    "failed_trial",
+    "fastest_reliable",
+    "parse_ticks",
+    "plan",
+    "render_table",
+    "run_trial",
+    "summarise",
+    "sweep",
+    "to_json",
+    "trial_seed",
+    "tune",
+    "verdict",
+]

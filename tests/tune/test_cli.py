@@ -1,0 +1,58 @@
+"""``dial tune`` on the command line: usage errors, and one small sweep on the real engine."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from dial.cli import main
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--ticks", "0.5:0.1:3"], "dial: --ticks: need 0 < A <= B, got A=0.5 s and B=0.1 s"),
+        (["--ticks", "0.1:0.5"], "dial: --ticks: expected A:B:N (e.g. 0.05:0.5:10), got"),
+        (["--ticks", "0.1:0.5:3", "--trials", "0"], "dial: --trials must be at least 1, got 0"),
+        (["--ticks", "0.1:0.5:3", "--jobs", "0"], "dial: --jobs must be at least 1, got 0"),
+        (["--ticks", "0.1:0.5:3", "--seed", "-1"], "dial: --seed must be 0 or more, got -1"),
+        (["--ticks", "0.1:0.5:3", "--perturb", "-2"], "dial: --perturb must be 0 mm or more"),
+    ],
+)
+def test_usage_errors_exit_2_with_a_clear_message(
+    args: list[str], message: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    assert main(["tune", "lightbulb", *args]) == 2
+    assert capsys.readouterr().err.startswith(message)
+
+
+def test_missing_ticks_is_a_usage_error() -> None:
+    with pytest.raises(SystemExit) as info:
+        main(["tune", "lightbulb"])
+    assert info.value.code == 2
+
+
+def test_a_script_error_stops_the_sweep_before_it_starts(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    bad = tmp_path / "bad.dial"
+    bad.write_text("% go hand_pos x\n\ngo #\n")
+    assert main(["tune", str(bad), "--ticks", "0.1:0.2:2"]) == 1
+    assert "unknown instruction 'hand_pos'" in capsys.readouterr().err
+
+
+def test_small_lightbulb_sweep_prints_table_json_and_plot(
+    in_root: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    png = tmp_path / "sweep.png"
+    args = ["tune", "scripts/lightbulb.dial", "--ticks", "0.05:0.1:2", "--jobs", "2"]
+    status = main([*args, "--json", "--plot", str(png)])
+    out = capsys.readouterr().out
+    table = json.loads(out.splitlines()[-1])
+    assert status == (0 if table["fastest_reliable_tick"] is not None else 1)
+    assert [(t["tick"], t["trials"]) for t in table["ticks"]] == [(0.05, 1), (0.1, 1)]
+    assert all(t["tick_length"] == t["tick"] for t in table["ticks"])
+    assert "tick (s)" in out and f"plot written to {png}" in out
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
