@@ -71,7 +71,10 @@ class MujocoRobot:
         self._saturated_since = np.full(32, -1.0)
         self._saturation_logged = np.zeros(32, dtype=bool)
         self._tactile_adr = [int(a) for a in ix.tactile_sensors]
-        self._arm_range = model.jnt_range[model.actuator_trnid[ix.arm_actuators, 0]]
+        arm_range = model.jnt_range[model.actuator_trnid[ix.arm_actuators, 0]]
+        self._arm_lo = arm_range[:, 0] - LIMIT_SLACK
+        self._arm_hi = arm_range[:, 1] + LIMIT_SLACK
+        self._pinned_at = ix.tension_limit - 1e-6
         hand_joints = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, n) for n in HAND_JOINTS]
         self.hand_range = model.jnt_range[hand_joints].copy()  # (16, 2) rad, mask order
         self.pace: float | None = None  # wall seconds per simulated second, for --realtime
@@ -83,20 +86,21 @@ class MujocoRobot:
 
     def snapshot(self) -> Snapshot:
         d, ix = self.data, self.index
-        tensions = d.sensordata[ix.tension_sensors]
+        tensions = d.sensordata[ix.tension_sensors]  # fancy indexing: already a copy
+        # Fancy-indexed arrays are fresh copies: freeze them in place; copy only views.
         return Snapshot(
-            time=self.steps * self.model.opt.timestep,
+            time=self.time,
             step=self.steps,
-            arm_q=frozen(d.qpos[ix.arm_qpos]),
+            arm_q=frozen(d.qpos[ix.arm_qpos], fresh=True),
             arm_target=frozen(self.arm_target),
-            hand_q=frozen(d.qpos[ix.hand_qpos]),
+            hand_q=frozen(d.qpos[ix.hand_qpos], fresh=True),
             hand_target=frozen(self.hand_target),
-            tensions=frozen(tensions),
-            differentials=frozen(tensions[0::2] - tensions[1::2]),
-            tactile=frozen(self.tactile()),
+            tensions=frozen(tensions, fresh=True),
+            differentials=frozen(tensions[0::2] - tensions[1::2], fresh=True),
+            tactile=frozen(self.tactile(), fresh=True),
             tool_pos=frozen(d.site_xpos[ix.tool_site]),
             tool_rot=frozen(d.site_xmat[ix.tool_site].reshape(3, 3)),
-            tips=frozen(d.site_xpos[ix.fingertip_sites]),
+            tips=frozen(d.site_xpos[ix.fingertip_sites], fresh=True),
             trips=dict(self._trips),
         )
 
@@ -212,18 +216,21 @@ class MujocoRobot:
     # -- safety monitors --------------------------------------------------------------------------
     def _monitor(self) -> str | None:
         d, ix = self.data, self.index
-        if not (np.isfinite(d.qpos).all() and np.isfinite(d.qvel).all()):
-            return "the physics state is not finite (the simulation diverged)"
+        # MuJoCo resets the state itself when it meets a bad qacc/qpos/qvel, and counts a
+        # warning: a nonzero count is the divergence (the state is no longer the run's).
+        for warning in _DIVERGENCE:
+            if d.warning[warning].number:
+                return "the physics diverged (MuJoCo reset an unstable state)"
         q = d.qpos[ix.arm_qpos]
-        lo, hi = self._arm_range[:, 0], self._arm_range[:, 1]
-        over = np.flatnonzero((q < lo - LIMIT_SLACK) | (q > hi + LIMIT_SLACK))
-        if over.size:
-            j = int(over[0])
+        if ((q < self._arm_lo) | (q > self._arm_hi)).any():
+            j = int(np.flatnonzero((q < self._arm_lo) | (q > self._arm_hi))[0])
             return f"PUMA joint {j + 1} is beyond its limit ({np.degrees(q[j]):.1f} deg)"
         # A tendon pinned at its limit is not a fault (a fist pressed into the palm does it),
         # but a researcher should know: log it once per episode.
-        tensions = d.sensordata[ix.tension_sensors]
-        pinned = tensions >= ix.tension_limit - 1e-6
+        pinned = d.sensordata[ix.tension_sensors] >= self._pinned_at
+        if not pinned.any() and not self._saturation_logged.any():
+            self._saturated_since.fill(-1.0)
+            return None
         self._saturated_since[~pinned] = -1.0
         self._saturated_since[pinned & (self._saturated_since < 0)] = self.time
         held = pinned & (self.time - self._saturated_since >= SATURATION_LIMIT_S)
@@ -238,6 +245,13 @@ class MujocoRobot:
             )
         self._saturation_logged = held | (self._saturation_logged & pinned)
         return None
+
+
+_DIVERGENCE = (
+    mujoco.mjtWarning.mjWARN_BADQACC,
+    mujoco.mjtWarning.mjWARN_BADQPOS,
+    mujoco.mjtWarning.mjWARN_BADQVEL,
+)
 
 
 class Slots:

@@ -89,31 +89,24 @@ class ArmIK(_Base):
     def solve(self, pos: FloatArray, rot: FloatArray, arm_q: FloatArray, what: str) -> FloatArray:
         """Converge on the pose; raise :class:`IKError` if it is out of reach.
 
-        Differential IK from ``arm_q`` can stall against a joint limit far from the goal, so
-        a few fixed wrist and elbow variations of the start are tried as well, and the
-        solution nearest ``arm_q`` among those that converge wins. Deterministic.
+        Differential IK from ``arm_q`` finds the solution in its own basin, which is the one
+        to keep (no wrist flip). It can stall against a joint limit far from the goal; then
+        fixed wrist and elbow variations of the start are tried in order, and the first that
+        converges wins. Deterministic.
         """
         start = np.asarray(arm_q, dtype=np.float64)
-        best: tuple[float, FloatArray] | None = None
         closest = (np.inf, np.inf)
         for offset in _SEEDS:
             self._set(start + offset)
             perr, rerr = self._iterate(pos, rot, 200)
-            q = self.config.q[self.index.arm_qpos].copy()
             if perr <= 2e-3 and rerr <= 1e-2:
-                distance = float(np.abs(q - start).max())
-                if best is None or distance < best[0] - 1e-9:
-                    best = (distance, q)
-                if distance < 0.5:
-                    break  # near the start: no other seed can be much nearer
-            elif perr < closest[0]:
-                closest = (perr, rerr)
-        if best is None:
-            raise IKError(
-                f"{what} is out of the arm's reach: the tool stays {closest[0] * 1000:.1f} mm "
-                f"and {np.degrees(closest[1]):.1f} deg away"
-            )
-        return best[1]
+                q: FloatArray = self.config.q[self.index.arm_qpos].copy()
+                return q
+            closest = min(closest, (perr, rerr))
+        raise IKError(
+            f"{what} is out of the arm's reach: the tool stays {closest[0] * 1000:.1f} mm "
+            f"and {np.degrees(closest[1]):.1f} deg away"
+        )
 
 
 # Start offsets for ArmIK.solve: as given, then wrist (joints 4 and 6) and elbow variations.

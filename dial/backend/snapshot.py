@@ -47,7 +47,8 @@ class Snapshot:
     trips: Mapping[int, Trip]
 
 
-def frozen(array: NDArray[np.float64]) -> FloatArray:
-    out = np.array(array, dtype=np.float64)
+def frozen(array: NDArray[np.float64], fresh: bool = False) -> FloatArray:
+    """A read-only array: a copy, or ``array`` itself when it is ``fresh`` (owned by no one)."""
+    out = array if fresh else np.array(array, dtype=np.float64)
     out.flags.writeable = False
     return out

@@ -1,0 +1,47 @@
+"""Engine-owned safety monitors on the MuJoCo driver."""
+
+from __future__ import annotations
+
+import mujoco
+import trio
+
+from dial.backend.driver import MujocoRobot
+from dial.backend.model import load_model
+from dial.scene import models_dir
+
+
+def _robot() -> MujocoRobot:
+    model = load_model(models_dir() / "utah_hand_puma" / "scene_surface.xml")
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    return MujocoRobot(model, data)
+
+
+def test_a_diverging_state_is_a_fault() -> None:
+    robot = _robot()
+    assert trio.run(robot.advance) is None
+    robot.data.qvel[robot.index.hand_dof[0]] = 1e12  # beyond MuJoCo's bound: it resets
+    assert trio.run(robot.advance) == "the physics diverged (MuJoCo reset an unstable state)"
+
+
+def test_an_arm_joint_past_its_limit_is_a_fault() -> None:
+    robot = _robot()
+    j = robot.index.arm_qpos[1]
+    robot.data.qpos[j] = robot.model.jnt_range[1, 1] + 0.2  # joint 2, far past its stop
+    robot.arm_target = robot.data.qpos[robot.index.arm_qpos].copy()
+    fault = trio.run(robot.advance)
+    assert fault is not None and fault.startswith("PUMA joint 2 is beyond its limit")
+
+
+def test_a_tendon_held_at_its_limit_is_logged_once_per_episode() -> None:
+    robot = _robot()
+    robot.arm_target = robot.data.qpos[robot.index.arm_qpos].copy()
+    robot._pinned_at = 5.0  # below the 10 N pretension: every tendon counts as pinned
+    for _ in range(99):  # 0.99 s: not yet held for a second
+        assert trio.run(robot.advance) is None
+    assert robot.log.of("warning") == []
+    for _ in range(100):  # a run never aborts for it
+        assert trio.run(robot.advance) is None
+    warnings = robot.log.of("warning")
+    assert len(warnings) == 32  # each tendon once, not once per period
+    assert "index joint 0 flexor tendon held at its 50 N limit for 1 s" in warnings[0]["message"]
