@@ -94,8 +94,13 @@ def tune(
             )
             status = 1
         else:
-            plot(rows, options.plot, title)
-            print(f"plot written to {options.plot}", file=out)
+            try:
+                plot(rows, options.plot, title)
+            except (OSError, ValueError) as e:  # an unwritable path, an unknown file type
+                print(f"dial: --plot {options.plot}: {e}", file=err)
+                status = 1
+            else:
+                print(f"plot written to {options.plot}", file=out)
     if options.json:
         meta = {
             "script": str(path),

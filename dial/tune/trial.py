@@ -98,7 +98,5 @@ def sweep(
     ran = executor.map(
         functools.partial(run_trial, backend), [trials[i] for i in order], failed_trial, progress
     )
-    results: list[TrialResult | None] = [None] * len(trials)
-    for i, result in zip(order, ran, strict=True):
-        results[i] = result
-    return [r for r in results if r is not None]
+    by_index = dict(zip(order, ran, strict=True))
+    return [by_index[i] for i in range(len(trials))]

@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import mujoco
+import pytest
 import trio
 
 from dial.backend.driver import MujocoRobot
@@ -17,7 +20,8 @@ def _robot() -> MujocoRobot:
     return MujocoRobot(model, data)
 
 
-def test_a_diverging_state_is_a_fault() -> None:
+def test_a_diverging_state_is_a_fault(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.chdir(tmp_path)  # MuJoCo writes its warning to MUJOCO_LOG.TXT here
     robot = _robot()
     assert trio.run(robot.advance) is None
     robot.data.qvel[robot.index.hand_dof[0]] = 1e12  # beyond MuJoCo's bound: it resets

@@ -130,6 +130,13 @@ def test_tune_plot_without_matplotlib_prints_the_table_and_exits_1(
     assert not (tmp_path / "p.png").exists()
 
 
+def test_tune_plot_that_cannot_be_written_is_reported_after_the_table(tmp_path: Path) -> None:
+    status, out, err = _tune(tmp_path, "0.25:0.3:2", plot=tmp_path / "no" / "p.png")
+    assert status == 1
+    assert "fastest reliable tick: 0.25 s" in out
+    assert f"dial: --plot {tmp_path / 'no' / 'p.png'}: [Errno 2] No such file" in err
+
+
 def test_ticks_that_are_not_whole_control_periods_are_noted(tmp_path: Path) -> None:
     _, out, _ = _tune(tmp_path, "0.25:0.255:2")
     assert "note: ticks are whole control periods: 0.255 s ran as 0.26 s" in out
