@@ -4,7 +4,10 @@ The motion runs at ``speed`` in simulated time (a safe approach speed, not tick
 time), so a guarded move that outlasts its ticks stretches its last tick. The
 guard is armed in the driver, which freezes the effector at the physics step
 where the contact is first sensed; the run then ends ``done`` with the contact,
-or ``missed`` when it reaches ``max`` travel without one.
+or ``missed`` when it reaches ``max`` travel without one. With ``press`` the
+effector is then set that much further on from where it stopped, so that a
+light contact holds for the sensing that follows instead of fading as the
+servo settles.
 """
 
 from __future__ import annotations
@@ -13,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from dial.backend.snapshot import Snapshot
+from dial.backend.snapshot import FloatArray, Snapshot
 from dial.instructions.types import FINGERS
 from dial.primitives.context import Context, RobotPrimitive, done, missed
 from dial.scheduler.types import Ended, Now, RunInfo
@@ -28,6 +31,7 @@ class GuardedMove(RobotPrimitive):
         self.length = float(self.arg("max") or np.linalg.norm(d))
         self.direction = d / np.linalg.norm(d)
         self.speed = float(self.arg("speed"))
+        self.press = float(self.arg("press"))
         sense = self.arg("sense")
         if sense is not None:
             self.sense: tuple[int, ...] = (int(sense),)
@@ -55,6 +59,13 @@ class GuardedMove(RobotPrimitive):
         trip = snapshot.trips.get(self.guard)
         travel = min(self.speed * (now.elapsed - self.info.period), self.length)
         if trip is not None:
+            if self.press > 0.0:  # the driver froze the effector at contact: lean in a little
+                if self.finger is None:
+                    pos = self.ctx.arm_ik.fk(snapshot.arm_q)[0]
+                    self._command(pos + self.delta * self.press, snapshot.arm_q, self.hand, 5)
+                else:
+                    tip = self.ctx.finger_ik.tip(snapshot.arm_q, snapshot.hand_q, self.finger)
+                    self._command(tip + self.delta * self.press, self.arm_q, snapshot.hand_q, 5)
             return done(
                 kind=trip.kind,
                 finger=FINGERS[trip.finger],
@@ -66,13 +77,19 @@ class GuardedMove(RobotPrimitive):
         if travel >= self.length:
             return missed(f"no contact within {self.length * 1000:.0f} mm", travel=travel)
         goal = self.p0 + self.delta * (travel + self.speed * self.info.period)
+        self._command(goal, self.arm_q, self.hand, 2)
+        return None
+
+    def _command(
+        self, goal: FloatArray, arm_q: FloatArray, hand_q: FloatArray, iterations: int
+    ) -> None:
+        """Set the moving effector toward ``goal`` (tool or fingertip position, world m)."""
         if self.finger is None:
-            self.arm_q = self.ctx.arm_ik.track(goal, self.r0, self.arm_q)
+            self.arm_q = self.ctx.arm_ik.track(goal, self.r0, arm_q, iterations)
             self.slots.arm(self.arm_q)
         else:
-            self.hand = self.ctx.finger_ik.track(self.finger, goal, self.arm_q, self.hand)
+            self.hand = self.ctx.finger_ik.track(self.finger, goal, arm_q, hand_q, iterations)
             self.slots.joints(0xF << (4 * self.finger), self.hand)
-        return None
 
     def stop(self) -> None:
         self.ctx.robot.disarm(self.guard)
