@@ -9,6 +9,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from dial.instructions.scene_names import SceneNotFoundError
+from dial.resources import data_dir
 
 ROBOT_DIR = "utah_hand_puma"
 # The shared hand-pose file sits beside the world files but is not a scene.
@@ -17,11 +18,7 @@ POSES_FILE = "hand_poses.toml"
 
 def models_dir() -> Path:
     """The model directory: ``dial/_data/models`` if installed, else the checkout's ``models/``."""
-    package = Path(__file__).resolve().parent.parent
-    installed = package / "_data" / "models"
-    if installed.is_dir():
-        return installed
-    return package.parent / "models"
+    return data_dir("models")
 
 
 def worlds_dir() -> Path:
