@@ -224,8 +224,9 @@ def test_extends_a_bundled_scene_by_name_and_detects_cycles(tmp_path: Path) -> N
         'extends = "containment"\n[objects]\ntarget = "containment_rounded"\n',
     )
     world = load_world(mine)
-    assert world.name == "mine" and world.locations["contain_target"].body == "containment_rounded"
-    assert load_scene_names("mine.toml", tmp_path).programs == {"to_object", "retract_arm"}
+    assert world.name == "mine" and world.locations["side_135"].body == "containment_rounded"
+    programs = {"to_object", "to_top", "leave_top", "back_side", "retract_arm"}
+    assert load_scene_names("mine.toml", tmp_path).programs == programs
     write(tmp_path / "a.toml", 'extends = "b.toml"\n')
     write(tmp_path / "b.toml", 'extends = "a.toml"\n')
     with pytest.raises(WorldFileError, match=r"extends cycle: .*a.toml -> .*b.toml -> .*a.toml"):
