@@ -25,3 +25,29 @@ def golden(path: Path, actual: str) -> None:
 def in_root(monkeypatch: pytest.MonkeyPatch) -> Path:
     monkeypatch.chdir(ROOT)
     return ROOT
+
+
+# A short run on the surface scene: an arm program, a hand pose, a grasp that stretches its
+# tick, a relative arm move and sensing. Enough for the engine and recording tests.
+SHORT = """\
+@scene surface
+@tick 0.1
+% to     puma_command "ex to_block"
+% open   hand_pose    "open_hand"
+% grab   grasp_force  "0x0666_0x0222 2N" timeout=3s
+% down   arm_move     0 0 -0.02 frame=world
+% forces get_forces
+
+to     #====
+open   #--
+grab        #
+down         #=
+forces         #
+"""
+
+
+@pytest.fixture
+def short_script(tmp_path: Path) -> Path:
+    path = tmp_path / "short.dial"
+    path.write_text(SHORT)
+    return path

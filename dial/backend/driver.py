@@ -16,7 +16,8 @@ import mujoco
 import numpy as np
 import trio
 
-from dial.backend.model import HAND_JOINTS, RobotIndex, hand_ctrl
+from dial.backend.contact import contact_reading
+from dial.backend.model import HAND_JOINTS, RobotIndex, hand_ctrl, tendon_differentials
 from dial.backend.snapshot import FloatArray, Snapshot, Trip, frozen
 from dial.errors import DialError
 from dial.instructions.types import FINGERS
@@ -25,7 +26,6 @@ from dial.scheduler.log import EventLog
 
 CONTROL_PERIOD = 0.01  # s; physics runs at the model's timestep (0.002 s)
 SATURATION_LIMIT_S = 1.0  # a tendon pinned at its tension limit this long is logged
-POSITION_LEVER = 0.1  # m: joint error (rad) to fingertip displacement, about a finger length
 LIMIT_SLACK = 0.05  # rad: the servo may press a joint this far into its limit stop
 
 
@@ -41,7 +41,6 @@ class Guard:
     conditions: tuple[tuple[str, float], ...]
     sense: tuple[int, ...]
     baseline: FloatArray  # (16,) differentials when armed, for force conditions
-    trip: Trip | None = None
 
 
 class MujocoRobot:
@@ -86,7 +85,6 @@ class MujocoRobot:
 
     def snapshot(self) -> Snapshot:
         d, ix = self.data, self.index
-        tensions = d.sensordata[ix.tension_sensors]  # fancy indexing: already a copy
         # Fancy-indexed arrays are fresh copies: freeze them in place; copy only views.
         return Snapshot(
             time=self.time,
@@ -95,8 +93,8 @@ class MujocoRobot:
             arm_target=frozen(self.arm_target),
             hand_q=frozen(d.qpos[ix.hand_qpos], fresh=True),
             hand_target=frozen(self.hand_target),
-            tensions=frozen(tensions, fresh=True),
-            differentials=frozen(tensions[0::2] - tensions[1::2], fresh=True),
+            tensions=frozen(d.sensordata[ix.tension_sensors], fresh=True),
+            differentials=frozen(tendon_differentials(d, ix), fresh=True),
             tactile=frozen(self.tactile(), fresh=True),
             tool_pos=frozen(d.site_xpos[ix.tool_site]),
             tool_rot=frozen(d.site_xmat[ix.tool_site].reshape(3, 3)),
@@ -155,8 +153,8 @@ class MujocoRobot:
         self, effector: str, conditions: Iterable[tuple[str, float]], sense: Iterable[int]
     ) -> int:
         """Arm a guard; it is checked after every physics step until disarmed."""
-        tensions = self.data.sensordata[self.index.tension_sensors]
-        guard = Guard(effector, tuple(conditions), tuple(sense), tensions[0::2] - tensions[1::2])
+        baseline = tendon_differentials(self.data, self.index)
+        guard = Guard(effector, tuple(conditions), tuple(sense), baseline)
         self._next_guard += 1
         self.guards[self._next_guard] = guard
         return self._next_guard
@@ -167,32 +165,26 @@ class MujocoRobot:
 
     def _check_guards(self) -> None:
         d, ix = self.data, self.index
-        tensions = None
+        differentials = tendon_differentials(d, ix)
+        q = d.qpos[ix.hand_qpos]
         for gid, guard in list(self.guards.items()):
-            for kind, threshold in guard.conditions:
-                for f in guard.sense:
-                    if kind == "tactile":
-                        a = self._tactile_adr[f]
-                        value = float(d.sensordata[a : a + 256].max())
-                    elif kind == "force":
-                        if tensions is None:
-                            tensions = d.sensordata[ix.tension_sensors]
-                        diff = tensions[0::2] - tensions[1::2]
-                        value = float(np.abs(diff - guard.baseline)[4 * f : 4 * f + 4].max())
-                    else:
-                        err = (
-                            self.hand_target[4 * f : 4 * f + 4]
-                            - d.qpos[ix.hand_qpos[4 * f : 4 * f + 4]]
-                        )
-                        value = float(np.linalg.norm(err)) * POSITION_LEVER
-                    if value >= threshold:
-                        self._trip(gid, guard, Trip(self.time, self.steps, kind, f, value))
-                        break
-                if guard.trip is not None:
-                    break
+            trip = self._first_trip(guard, differentials, q)
+            if trip is not None:
+                self._trip(gid, guard, trip)
+
+    def _first_trip(self, guard: Guard, differentials: FloatArray, q: FloatArray) -> Trip | None:
+        sd = self.data.sensordata
+        for kind, threshold in guard.conditions:
+            for f in guard.sense:
+                a = self._tactile_adr[f]
+                value = contact_reading(
+                    kind, f, sd[a : a + 256], differentials, self.hand_target, q, guard.baseline
+                )
+                if value >= threshold:
+                    return Trip(self.time, self.steps, kind, f, value)
+        return None
 
     def _trip(self, gid: int, guard: Guard, trip: Trip) -> None:
-        guard.trip = trip
         self._trips[gid] = trip
         del self.guards[gid]
         ix, d = self.index, self.data

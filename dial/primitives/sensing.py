@@ -7,7 +7,7 @@ from typing import Any
 import mujoco
 import numpy as np
 
-from dial.backend.driver import POSITION_LEVER
+from dial.backend.contact import contact_reading
 from dial.backend.snapshot import FloatArray, Snapshot
 from dial.haptics import FitError, fit_plane, fit_superquadric
 from dial.instructions.types import FINGERS
@@ -34,14 +34,15 @@ class Get(InstantPrimitive):
 
 def contact_value(kind: str, snapshot: Snapshot, finger: int, baseline: FloatArray | None) -> float:
     """The reading a contact condition compares with its threshold (m or N)."""
-    joints = slice(4 * finger, 4 * finger + 4)
-    if kind == "tactile":
-        return float(snapshot.tactile[finger].max())
-    if kind == "force":
-        diff = snapshot.differentials[joints]
-        return float(np.abs(diff - (baseline[joints] if baseline is not None else 0.0)).max())
-    err = snapshot.hand_target[joints] - snapshot.hand_q[joints]
-    return float(np.linalg.norm(err)) * POSITION_LEVER
+    return contact_reading(
+        kind,
+        finger,
+        snapshot.tactile[finger],
+        snapshot.differentials,
+        snapshot.hand_target,
+        snapshot.hand_q,
+        baseline,
+    )
 
 
 class ContactWait(RobotPrimitive):

@@ -217,7 +217,7 @@ class Runner:
                 self.clock += 1
                 await self._period(stretched=False)
             for a in [a for a in mine if a.fixed and a.ended is None and a.info.run.exec_end == k]:
-                ended = self._guard(a, lambda a=a: a.prim.finish(self.robot.snapshot()))
+                ended = self._guard(lambda a=a: a.prim.finish(self.robot.snapshot()))
                 self._end(a, ended, self.sim_time)
             await self._reap()
             stretch = 0
@@ -280,7 +280,7 @@ class Runner:
         assert isinstance(prim, InstantPrimitive)
         if not condition:
             self._write_start(script, run)
-        ended = self._guard(None, lambda: prim.sense(self.robot.snapshot()))
+        ended = self._guard(lambda: prim.sense(self.robot.snapshot()))
         self._record_end(script, run, ended, self.sim_time)
         if ended.outcome in self.abort_on:
             raise self._aborted(script, run, ended)
@@ -306,7 +306,7 @@ class Runner:
             # A one-tick run is a GOTO MOVE: the set-point jumps at once.
             progress = 1.0 if a.span == self.n else min(1.0, (self.clock - a.start_clock) / a.span)
             now = Now(t_end, self.tick, progress, elapsed, stretched)
-            ended = self._guard(a, lambda a=a, now=now: a.prim.step(snapshot, now))
+            ended = self._guard(lambda a=a, now=now: a.prim.step(snapshot, now))
             if (
                 ended is None
                 and not a.fixed
@@ -330,7 +330,7 @@ class Runner:
             raise self._abort
 
     @staticmethod
-    def _guard(a: _Active | None, call: Any) -> Any:
+    def _guard(call: Any) -> Any:
         """Run a primitive callback; a DialError it raises becomes an ``error`` outcome."""
         try:
             return call()
