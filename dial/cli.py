@@ -67,7 +67,7 @@ def cmd_check(args: argparse.Namespace) -> int:
     status = 0
     for arg in args.scripts:
         try:
-            script = _load(arg)
+            script = _load(arg, _scene_option(args.scene))
         except ScriptError as e:
             print(e.render())
             n = len(e.diagnostics)
@@ -80,7 +80,7 @@ def cmd_check(args: argparse.Namespace) -> int:
 
 
 def cmd_show(args: argparse.Namespace) -> int:
-    script = _load(args.script)
+    script = _load(args.script, _scene_option(args.scene))
     sys.stdout.write(render(script))
     return 0
 
@@ -263,6 +263,7 @@ def cmd_tune(args: argparse.Namespace) -> int:
         raise UsageError(f"--perturb must be 0 mm or more, got {args.perturb:g}")
     options = TuneOptions(
         script=args.script,
+        scene=_scene_option(args.scene),
         ticks=ticks,
         trials=args.trials,
         perturb_mm=args.perturb,
@@ -271,6 +272,15 @@ def cmd_tune(args: argparse.Namespace) -> int:
         json=args.json,
     )
     return tune(options, ProcessExecutor(args.jobs))
+
+
+def _scene_argument(p: argparse.ArgumentParser, verb: str) -> None:
+    p.add_argument(
+        "--scene",
+        metavar="NAME_OR_PATH",
+        help=f"{verb} in this scene instead of the script's @scene (the scripts it @calls "
+        "run in it too): a world file path, else a bundled scene name",
+    )
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -293,12 +303,7 @@ def build_parser() -> argparse.ArgumentParser:
         "error or a failed criterion, 130 on interrupt.",
     )
     p.add_argument("script", metavar="SCRIPT", help="script path or bundled name")
-    p.add_argument(
-        "--scene",
-        metavar="NAME_OR_PATH",
-        help="run in this scene instead of the script's @scene (also for the scripts it "
-        "@calls): a world file path, else a bundled scene name",
-    )
+    _scene_argument(p, "run")
     p.add_argument("--tick", type=float, metavar="S", help="tick length in s (default: @tick)")
     p.add_argument("--speed", type=float, default=1.0, metavar="F", help="divide the tick by F")
     p.add_argument("--seed", type=int, default=0, metavar="N", help="seed for --perturb")
@@ -356,6 +361,7 @@ def build_parser() -> argparse.ArgumentParser:
         "FILE:LINE:COL: message with the source line and a caret; exit 1 if any.",
     )
     p.add_argument("scripts", nargs="+", metavar="SCRIPT", help="script path or bundled name")
+    _scene_argument(p, "check")
     p.set_defaults(func=cmd_check)
 
     p = sub.add_parser(
@@ -367,6 +373,7 @@ def build_parser() -> argparse.ArgumentParser:
         "every run with its executing and held ticks.",
     )
     p.add_argument("script", metavar="SCRIPT", help="script path or bundled name")
+    _scene_argument(p, "check")
     p.set_defaults(func=cmd_show)
 
     p = sub.add_parser(
@@ -390,6 +397,7 @@ def build_parser() -> argparse.ArgumentParser:
         "plot could not be written), 2 on a usage error. See docs/tuning.md.",
     )
     p.add_argument("script", metavar="SCRIPT", help="script path or bundled name")
+    _scene_argument(p, "run")
     p.add_argument(
         "--ticks",
         required=True,

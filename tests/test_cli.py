@@ -37,6 +37,19 @@ def test_check_reports_every_file(capsys: pytest.CaptureFixture[str]) -> None:
     assert "bad_tick.dial:1:7:" in out and "bad_finger.dial:1:28:" in out
 
 
+def test_check_and_show_take_a_scene(in_root: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    # explore.dial and the procedures it calls are checked against the chosen scene.
+    assert main(["check", "scripts/explore.dial", "--scene", "explore_cylinder"]) == 0
+    assert main(["show", "scripts/explore.dial", "--scene", "explore_cylinder"]) == 0
+    out = capsys.readouterr().out
+    assert "scripts/explore.dial: OK" in out
+    assert "scripts/explore.dial: scene explore_cylinder," in out
+    assert main(["check", "scripts/explore.dial", "--scene", "pour"]) == 1
+    out = capsys.readouterr().out
+    assert "unknown program 'to_probe' in scene 'pour'" in out
+    assert "unknown program 'to_south' in scene 'pour', the caller's scene" in out
+
+
 def test_bundled_script_resolves_by_name(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:

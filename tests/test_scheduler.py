@@ -2,13 +2,20 @@
 
 from __future__ import annotations
 
+import signal
 from pathlib import Path
+from typing import Any
 
 import pytest
+import trio
+import trio.testing
 
 from dial.parser import check_text, expand, load
 from dial.scheduler import Outcome
-from dial.testing import Behaviour, run_fake
+from dial.scheduler.log import EventLog
+from dial.scheduler.runner import Runner
+from dial.scheduler.types import Ended, Now, Primitive, RunInfo
+from dial.testing import Behaviour, FakeFactory, FakeRobot, run_fake
 
 from .conftest import ROOT
 
@@ -209,3 +216,39 @@ def test_log_does_not_depend_on_trio_task_order(seed: int, monkeypatch: pytest.M
     trio_run._r.seed(seed)  # shuffles every batch of ready tasks differently per seed
     shuffled = run_fake(script, tick=0.05, behaviours=behaviours).log.records
     assert shuffled == reference
+
+
+class _CtrlC(Primitive):
+    """A run whose start is hit by Ctrl-C, as during a long native computation (an IK solve)."""
+
+    def start(self, snapshot: Any) -> None:
+        try:
+            signal.raise_signal(signal.SIGINT)  # the handler runs now, in this synchronous code
+        except KeyboardInterrupt:  # as native code may: daqp's solve turned it into this
+            raise ValueError(
+                "Buffer dtype mismatch, expected 'int' but got Python object"
+            ) from None
+
+    def step(self, snapshot: Any, now: Now) -> Ended | None:
+        return None
+
+
+def test_ctrl_c_stops_the_run_at_a_checkpoint_with_the_arm_held() -> None:
+    # Ctrl-C during a native computation must not surface as whatever error that code makes
+    # of a KeyboardInterrupt: the run ends as an interrupt (exit 130), logged, arm held.
+    script = check_text(ARM + HAND + "arm  #====\npose   #\n", "x.dial", origin=Path("x.dial"))
+    assert script is not None
+    robot, log = FakeRobot(), EventLog()
+    fake = FakeFactory(robot, {})
+
+    def factory(info: RunInfo) -> Primitive:
+        return _CtrlC() if info.event.name == "pose" else fake(info)
+
+    runner = Runner(robot, factory, 0.1, log)
+    with pytest.raises(KeyboardInterrupt):
+        trio.run(runner.run, script, clock=trio.testing.MockClock(autojump_threshold=0))
+    assert robot.held
+    last = log.records[-1]
+    assert last["kind"] == "interrupted" and last["tick"] == 3
+    assert last["t"] == pytest.approx(0.2, abs=0.011)  # at most a period after the signal
+    assert not [r for r in log.records if r["kind"] == "end"]  # the arm's move never finished

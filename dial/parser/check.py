@@ -72,9 +72,11 @@ class _Checker:
         diags: list[Diagnostic],
         origin: Path,
         scene_override: str | None,
+        caller_scene: SceneNames | None = None,
     ) -> None:
         self.program = program
         self.scene_override = scene_override
+        self.caller_scene = caller_scene  # a called script runs in its caller's scene
         self.origin = origin  # the real file, for resolving @call and @scene paths
         self.lines = source.split("\n")
         self.loader = loader
@@ -108,6 +110,9 @@ class _Checker:
         )
 
     def load_scene(self) -> None:
+        if self.caller_scene is not None:
+            self.scene = self.caller_scene
+            return
         setting = self.program.scene
         text = self.scene_override or (setting.text if setting is not None else None)
         if text is None or self.loader is None:
@@ -173,9 +178,19 @@ class _Checker:
             self.error(
                 spans[spec.name],
                 f"event '{event}': unknown {kind} '{value}' in scene '{self.scene.name}'"
-                f"{_hint(str(value), known)}{_choices(known)}",
+                f"{self.written_for()}{_hint(str(value), known)}{_choices(known)}",
             )
         return ok
+
+    def written_for(self) -> str:
+        """For a called script written for another scene: why its names are looked up here."""
+        own, caller = self.program.scene, self.caller_scene
+        if caller is None or own is None or Path(own.text).stem == caller.name:
+            return ""
+        return (
+            f", the caller's scene (this script's own '@scene {own.text}' applies only when it "
+            "runs by itself)"
+        )
 
     def diagram_events(self, body: tuple[Statement, ...]) -> set[str]:
         names: set[str] = set()
@@ -298,18 +313,9 @@ class _Checker:
         before = len(self.diags)
         display = str(Path(self.program.path).parent / stmt.target)
         callee = check_file(
-            target, self.loader, self.stack, self.diags, display, self.scene_override
+            target, self.loader, self.stack, self.diags, display, self.scene_override, self.scene
         )
         if callee is None or len(self.diags) > before:
-            return None
-        mine, theirs = self.program.scene, callee.program.scene
-        overridden = self.scene_override is not None  # every script runs in the chosen scene
-        if not overridden and mine is not None and theirs is not None and mine.text != theirs.text:
-            self.error(
-                stmt.span,
-                f"called script '{stmt.target}' needs scene '{theirs.text}' "
-                f"but this script uses '{mine.text}'",
-            )
             return None
         return callee
 
@@ -322,12 +328,15 @@ def check_text(
     diags: list[Diagnostic] | None = None,
     origin: Path | None = None,
     scene: str | None = None,
+    caller_scene: SceneNames | None = None,
 ) -> Script | None:
     """Parse and check ``text``; append problems to ``diags`` (raise if ``diags`` is None).
 
     ``path`` is how messages name the file; ``origin`` is the real file that
     ``@call`` and ``@scene`` paths are relative to (default: ``path``). ``scene``, if
     given, replaces the ``@scene`` of this script and of every script it calls.
+    ``caller_scene`` is the scene of the script that calls this one, if any: a called
+    script's names are checked against it, whatever its own ``@scene`` says.
     """
     own = diags is None
     sink: list[Diagnostic] = [] if diags is None else diags
@@ -335,7 +344,9 @@ def check_text(
     sink.extend(syntax)
     origin = Path(path) if origin is None else origin
     resolved = str(origin.resolve())
-    script = _Checker(program, text, loader, (*stack, resolved), sink, origin, scene).run()
+    script = _Checker(
+        program, text, loader, (*stack, resolved), sink, origin, scene, caller_scene
+    ).run()
     if own and sink:
         raise ScriptError(sink)
     return script
@@ -348,10 +359,13 @@ def check_file(
     diags: list[Diagnostic] | None = None,
     display: str | None = None,
     scene: str | None = None,
+    caller_scene: SceneNames | None = None,
 ) -> Script | None:
     """Read, parse and check the script at ``path`` (``display`` is how errors name it)."""
     text = Path(path).read_text(encoding="utf-8", errors="replace")
-    return check_text(text, display or str(path), loader, stack, diags, Path(path), scene)
+    return check_text(
+        text, display or str(path), loader, stack, diags, Path(path), scene, caller_scene
+    )
 
 
 def load(

@@ -44,7 +44,8 @@ def render(script: Script, layout: Layout | None = None) -> str:
             names.append(p.run.event)
     width = max([len(n) for n in names] + [len("tick")]) + 2
     tick = f"tick {script.tick:g} s" if script.tick is not None else "default tick"
-    scene = script.program.scene.text if script.program.scene else "none"
+    own = script.program.scene.text if script.program.scene else None
+    scene = script.scene_override or own or "none"
     out = [f"{script.path}: scene {scene}, {tick}, {layout.length} ticks", ""]
     out.append("tick".ljust(width) + _ruler(layout.length))
     for name in names:

@@ -237,8 +237,11 @@ def _name(reader: Reader, table: str, name: str) -> str:
 def _load_merged(path: Path, seen: tuple[Path, ...]) -> dict[str, Any]:
     """The file's data with ``extends`` applied: tables merge key by key, the child winning.
 
-    Paths in ``[scene]`` are made absolute against the file that wrote them, so a world file
-    may extend one in another directory (or a bundled scene, by name).
+    ``extends`` names one world file or a list of them. Bases merge in order; a key that two
+    bases set differently is an error unless the child sets it too (a silent winner would
+    hide which definition a script gets). Paths in ``[scene]`` are made absolute against the
+    file that wrote them, so a world file may extend one in another directory (or a bundled
+    scene, by name).
     """
     reader = Reader(path)
     if path in seen:
@@ -252,19 +255,50 @@ def _load_merged(path: Path, seen: tuple[Path, ...]) -> dict[str, Any]:
                 scene[key] = str((path.parent / scene[key]).resolve())
     if "extends" not in data:
         return data
-    base_name = reader.string(data.pop("extends"), "extends")
-    try:
-        base_path = resolve_scene(base_name, path.parent).resolve()
-    except LookupError as e:
-        raise reader.error("extends", str(e)) from None
-    return _merge(_load_merged(base_path, (*seen, path)), data)
+    value = data.pop("extends")
+    names = [value] if isinstance(value, str) else value
+    if not isinstance(names, list) or not names or not all(isinstance(n, str) for n in names):
+        raise reader.error("extends", "expected a world file (name or path) or a list of them")
+    merged: dict[str, Any] = {}
+    setter: dict[tuple[str, ...], Path] = {}  # each base key -> the base that set it
+    mine = _leaves(data)
+    for name in names:
+        try:
+            base_path = resolve_scene(name, path.parent).resolve()
+        except LookupError as e:
+            raise reader.error("extends", str(e)) from None
+        base = _load_merged(base_path, (*seen, path))
+        theirs, before = _leaves(base), _leaves(merged)
+        for entry, leaf in theirs.items():
+            if entry in before and before[entry] != leaf and entry not in mine:
+                raise reader.error(
+                    ".".join(entry),
+                    f"set differently by {setter[entry].name} and {base_path.name}; "
+                    "set it in this file to choose",
+                )
+            setter[entry] = base_path
+        merged = _merge(merged, base)
+    return _merge(merged, data)
+
+
+def _leaves(data: Mapping[str, Any]) -> dict[tuple[str, ...], Any]:
+    """Every entry of a world file (``("poses", "grip")``, ``("scene", "model")``), by key."""
+    out: dict[tuple[str, ...], Any] = {}
+    for key, value in data.items():
+        if isinstance(value, dict):
+            out.update({(key, name): entry for name, entry in value.items()})
+        else:
+            out[(key,)] = value
+    return out
 
 
 def _merge(base: dict[str, Any], child: Mapping[str, Any]) -> dict[str, Any]:
+    """Tables merge entry by entry; an entry (a pose, a location, a criterion) is replaced
+    whole, so a redefined location does not keep, say, the ``object`` of the one it replaces."""
     out = dict(base)
     for key, value in child.items():
         if isinstance(value, dict) and isinstance(out.get(key), dict):
-            out[key] = _merge(out[key], value)
+            out[key] = {**out[key], **value}
         else:
             out[key] = value
     return out

@@ -11,6 +11,8 @@ reaches a result.
 from __future__ import annotations
 
 import math
+import signal
+import threading
 from collections import defaultdict
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -119,9 +121,12 @@ class Runner:
         self._root = script.path
         error: RunAborted | None = None
         interrupted = False
+        signalled: list[bool] = []
         try:
             async with trio.open_nursery() as nursery:
                 self._nursery = nursery
+                if threading.current_thread() is threading.main_thread():
+                    nursery.start_soon(self._await_interrupt, nursery.cancel_scope, signalled)
                 try:
                     await self._steps(script, script.timeline)
                 except RunAborted as e:
@@ -129,15 +134,15 @@ class Runner:
                     self.log.write(
                         "error", event=e.event, tick=e.tick, t=self.sim_time, message=str(e)
                     )
-                except KeyboardInterrupt:
+                except KeyboardInterrupt:  # off the main thread, trio raises it anywhere
                     interrupted = True
-                    self.log.write("interrupted", tick=self.tick, t=self.sim_time)
                 finally:
                     self.robot.hold_all()  # on abort, interrupt or bug: the arm never drops
                     nursery.cancel_scope.cancel()
         finally:
             self._nursery = None
-        if interrupted:
+        if interrupted or signalled:
+            self.log.write("interrupted", tick=self.tick, t=self.sim_time)
             raise KeyboardInterrupt
         return RunSummary(
             error is None,
@@ -148,6 +153,19 @@ class Runner:
             self.n * self.period,
             dict(sorted(self.counts.items())),
         )
+
+    @staticmethod
+    async def _await_interrupt(scope: trio.CancelScope, signalled: list[bool]) -> None:
+        """Turn Ctrl-C into a cancellation at the next checkpoint.
+
+        Left to trio, the KeyboardInterrupt is raised wherever the main thread happens to
+        be, e.g. inside a native IK solve, which can turn it into an unrelated error.
+        """
+        with trio.open_signal_receiver(signal.SIGINT) as signals:
+            async for _ in signals:
+                signalled.append(True)
+                scope.cancel()
+                return
 
     # -- structure --------------------------------------------------------------------------
     async def _steps(self, script: Script, steps: tuple[Step, ...]) -> None:

@@ -30,6 +30,7 @@ class TuneOptions:
     seed: int = 0
     plot: Path | None = None
     json: bool = False
+    scene: str | None = None  # dial run --scene: an absolute path or a bundled name
 
 
 @contextmanager
@@ -55,7 +56,7 @@ def tune(
     """Run the sweep and report it: 0 if some tick length always succeeded, else 1."""
     out, err = out or sys.stdout, err or sys.stderr  # looked up now: tests replace them
     path = resolve_script(options.script)
-    load(path, load_scene_names)  # a script with an error never starts a sweep
+    load(path, load_scene_names, scene=options.scene)  # an error never starts a sweep
     trials = plan(
         str(path.resolve()),
         str(path),
@@ -63,6 +64,7 @@ def tune(
         options.trials,
         options.seed,
         options.perturb_mm,
+        options.scene,
     )
     start = time.perf_counter()
     with _progress_bar(len(trials), err) as progress:
@@ -74,8 +76,9 @@ def tune(
         print("dial: without --perturb, the trials at each tick are the same run", file=err)
 
     rows = summarise(results)
+    scene = f" in scene {Path(options.scene).stem}" if options.scene else ""
     title = (
-        f"{path}: {options.trials} trial{'s' if options.trials != 1 else ''} per tick, "
+        f"{path}{scene}: {options.trials} trial{'s' if options.trials != 1 else ''} per tick, "
         f"perturb {options.perturb_mm:g} mm, seed {options.seed}"
     )
     width = shutil.get_terminal_size().columns if out.isatty() else 120
@@ -104,6 +107,7 @@ def tune(
     if options.json:
         meta = {
             "script": str(path),
+            "scene": options.scene,
             "trials": options.trials,
             "perturb_mm": options.perturb_mm,
             "seed": options.seed,

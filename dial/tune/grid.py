@@ -23,6 +23,7 @@ class Trial:
     trial: int  # 0 .. trials-1
     seed: int  # the seed of the --perturb direction
     perturb_mm: float
+    scene: str | None = None  # replaces the script's @scene, as dial run --scene
 
 
 def parse_ticks(text: str) -> tuple[float, ...]:
@@ -65,11 +66,12 @@ def plan(
     trials: int,
     seed: int = 0,
     perturb_mm: float = 0.0,
+    scene: str | None = None,
 ) -> list[Trial]:
     """Every trial of the sweep, tick by tick."""
     seeds = [trial_seed(seed, k) for k in range(trials)]
     return [
-        Trial(script, display, tick, k, seeds[k], perturb_mm)
+        Trial(script, display, tick, k, seeds[k], perturb_mm, scene)
         for tick in ticks
         for k in range(trials)
     ]

@@ -46,12 +46,13 @@ Backend = Callable[[Trial], RunReport]
 
 
 def engine_backend(trial: Trial) -> RunReport:
-    """Run the trial on the MuJoCo engine, as ``dial run --tick --seed --perturb`` would."""
+    """Run the trial on the MuJoCo engine, as ``dial run --tick --seed --perturb --scene``
+    would."""
     from dial.engine import RunOptions, run  # in the worker: the parent needs no MuJoCo
     from dial.parser.check import load
     from dial.scene import load_scene_names
 
-    script = load(trial.script, load_scene_names, display=trial.display)
+    script = load(trial.script, load_scene_names, display=trial.display, scene=trial.scene)
     options = RunOptions(tick=trial.tick, seed=trial.seed, perturb_mm=trial.perturb_mm)
     result = run(script, options)
     summary = result.summary

@@ -30,6 +30,9 @@ SCENES = (
     "containment",
     "containment_cylinder",
     "containment_rounded",
+    "explore_block",
+    "explore_cylinder",
+    "explore_rounded",
     "lightbulb",
     "pour",
     "surface",
@@ -75,7 +78,7 @@ def test_scene_path_wins_over_bundled_name(tmp_path: Path) -> None:
 def test_unknown_scene_lists_the_bundled_names(tmp_path: Path) -> None:
     with pytest.raises(SceneNotFoundError, match="unknown scene 'kitchen'") as e:
         load_scene_names("kitchen", tmp_path)
-    assert "containment, containment_cylinder, containment_rounded, lightbulb" in str(e.value)
+    assert "containment, containment_cylinder, containment_rounded, explore_block" in str(e.value)
 
 
 def test_containment_variants_change_only_the_target() -> None:
@@ -234,6 +237,73 @@ def test_extends_a_bundled_scene_by_name_and_detects_cycles(tmp_path: Path) -> N
     write(tmp_path / "c.toml", 'extends = "nowhere"\n')
     with pytest.raises(WorldFileError, match=r"c.toml: extends: unknown scene 'nowhere'"):
         load_world(tmp_path / "c.toml")
+
+
+def test_extends_a_list_merges_the_bases_in_order(tmp_path: Path) -> None:
+    lib = tmp_path / "lib"
+    lib.mkdir()
+    write(
+        lib / "a.toml", '[locations]\na = { object = "block", pos = [0, 0, 0.1], rpy = [0, 0, 0] }'
+    )
+    write(lib / "b.toml", '[programs]\nup = "MOVES a"\nback = "DEPART 0.1"')
+    base = _world(tmp_path, "")
+    mine = write(tmp_path / "mine.toml", f'extends = ["{base.name}", "lib/a.toml", "lib/b.toml"]\n')
+    world = load_world(mine)
+    assert world.model_path.name == "scene_surface.xml"
+    assert world.locations["a"].body == "surface_block"
+    assert set(world.programs) == {"up", "back"}
+
+
+def test_extends_a_list_rejects_a_name_two_bases_define_differently(tmp_path: Path) -> None:
+    base = _world(tmp_path, "").name
+    write(tmp_path / "p.toml", '[programs]\nback = "DEPART 0.1"')
+    write(tmp_path / "q.toml", '[programs]\nback = "DEPART 0.2"')
+    write(tmp_path / "same.toml", '[programs]\nback = "DEPART 0.1"')
+    clash = write(tmp_path / "clash.toml", f'extends = ["{base}", "p.toml", "q.toml"]\n')
+    with pytest.raises(
+        WorldFileError,
+        match=r"clash.toml: programs.back: set differently by p.toml and q.toml; set it in this",
+    ):
+        load_world(clash)
+    # The same definition twice is no conflict, and the child may settle one.
+    load_world(write(tmp_path / "ok.toml", f'extends = ["{base}", "p.toml", "same.toml"]\n'))
+    chosen = write(
+        tmp_path / "chosen.toml",
+        f'extends = ["{base}", "p.toml", "q.toml"]\n[programs]\nback = "DEPART 0.3"\n',
+    )
+    assert load_world(chosen).programs["back"].statements == (Depart(1, 0.3),)
+    for bad in ("[]", "3", '["p.toml", 3]'):
+        path = write(tmp_path / "bad.toml", f"extends = {bad}\n")
+        with pytest.raises(WorldFileError, match="extends: expected a world file"):
+            load_world(path)
+
+
+def test_a_redefined_location_replaces_the_whole_entry(tmp_path: Path) -> None:
+    # A world-frame location in the child does not keep the object of the base's location.
+    base = _world(
+        tmp_path, '[locations]\na = { object = "block", pos = [0, 0, 0.1], rpy = [0, 0, 0] }'
+    )
+    child = write(
+        tmp_path / "child.toml",
+        f'extends = "{base.name}"\n[locations]\na = {{ pos = [0.5, 0, 0.6], rpy = [180, 0, 0] }}\n',
+    )
+    assert load_world(child).locations["a"].body is None
+
+
+def test_explore_worlds_define_every_name_of_both_procedures() -> None:
+    block = load_world(worlds_dir() / "explore_block.toml")
+    cylinder = load_world(worlds_dir() / "explore_cylinder.toml")
+    for world in (block, cylinder):
+        names = world.scene_names()
+        assert {"to_probe", "to_south", "to_object", "back_side", "leave_north"} <= names.programs
+        assert {"trace_point", "probe", "top"} <= set(names.poses)
+        assert world.objects["block"] == world.objects["target"]
+    assert (
+        block.objects["target"] == "surface_block" and block.model_path.name == "scene_surface.xml"
+    )
+    assert [c.name for c in block.criteria] == ["top_plane"]
+    assert cylinder.objects["target"] == "containment_cylinder"
+    assert [c.name for c in cylinder.criteria] == ["shape_fit"]
 
 
 def test_parsing_does_not_import_mujoco() -> None:

@@ -3,11 +3,14 @@
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
 
 from dial.cli import main
+from dial.tune import plan
+from dial.tune.trial import engine_backend, run_trial
 
 
 @pytest.mark.parametrize(
@@ -56,3 +59,18 @@ def test_small_lightbulb_sweep_prints_table_json_and_plot(
     assert all(t["tick_length"] == t["tick"] for t in table["ticks"])
     assert "tick (s)" in out and f"plot written to {png}" in out
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_scene_reaches_the_check_and_every_trial(
+    in_root: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # explore.dial does not check in the pour scene: the sweep never starts.
+    args = ["tune", "scripts/explore.dial", "--ticks", "0.1:0.2:2", "--scene", "pour"]
+    assert main(args) == 1
+    assert "unknown program 'to_probe' in scene 'pour'" in capsys.readouterr().err
+    trials = plan("/x/go.dial", "go.dial", (0.1, 0.2), 2, scene="explore_block")
+    assert {t.scene for t in trials} == {"explore_block"}
+    # A worker loads the script in the trial's scene (here one that does not exist).
+    bad = replace(trials[0], script=str(in_root / "scripts" / "explore.dial"), scene="kitchen")
+    result = run_trial(engine_backend, bad)
+    assert not result.ok and "unknown scene 'kitchen'" in (result.error or "")
