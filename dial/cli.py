@@ -212,14 +212,17 @@ def cmd_run(args: argparse.Namespace) -> int:
 
 
 def _print_summary(result: Any, tick: float) -> None:
+    from dial.scheduler.log import qualified_event
+
     s = result.summary
     rtf = s.sim_time / result.wall_time if result.wall_time > 0 else float("inf")
     print(f"scene {result.world.name}: {s.ticks} ticks of {tick:g} s")
     ends = result.log.of("end")
-    width = max([len(r["event"]) for r in ends] + [5])
-    for r in ends:
+    names = [qualified_event(r) for r in ends]
+    width = max([len(n) for n in names] + [5])
+    for r, name in zip(ends, names, strict=True):
         note = f"  {r['message']}" if r.get("message") else ""
-        print(f"  tick {r['tick']:4d}  {r['event']:<{width}}  {r['outcome']}{note}")
+        print(f"  tick {r['tick']:4d}  {name:<{width}}  {r['outcome']}{note}")
     print(
         f"simulated {s.sim_time:.2f} s in {result.wall_time:.2f} s wall "
         f"(real-time factor {rtf:.1f}), {result.physics_steps} physics steps"

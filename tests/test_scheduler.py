@@ -181,18 +181,32 @@ def test_if_else_branches_on_a_sensed_outcome(first: Outcome, branch: str) -> No
 
 def test_call_runs_the_callee_with_its_own_events(tmp_path: Path) -> None:
     sub = tmp_path / "sub.dial"
-    sub.write_text('% arm hand_pose "point"\narm #=\n')
+    sub.write_text('% arm hand_pose "point"\n% j get_joints\narm #=\n@if j\narm #\n@end\n')
     main = tmp_path / "main.dial"
     main.write_text(ARM + "arm #\n@call sub.dial\narm #\n")
     script = check_text(main.read_text(), str(main))
     assert script is not None
     result = run_fake(script)
-    starts = result.log.of("start")
-    assert [(r["event"], r["tick"], r.get("script")) for r in starts] == [
-        ("arm", 1, None),
-        ("arm", 2, str(tmp_path / "sub.dial")),
-        ("arm", 4, None),
+    # Every record of the callee's events says whose they are: the names repeat.
+    callee = str(tmp_path / "sub.dial")
+    runs = [
+        (r["kind"], r["event"], r["tick"], r.get("script"))
+        for r in result.log.records
+        if r["kind"] in ("start", "end")
     ]
+    assert runs == [
+        ("start", "arm", 1, None),
+        ("end", "arm", 1, None),
+        ("start", "arm", 2, callee),
+        ("end", "arm", 3, callee),
+        ("end", "j", 3, callee),  # the condition-only sensing event, run by the @if
+        ("start", "arm", 4, callee),
+        ("end", "arm", 4, callee),
+        ("start", "arm", 5, None),
+        ("end", "arm", 5, None),
+    ]
+    (condition,) = result.log.of("condition")
+    assert condition["condition"] == "j" and condition["script"] == callee
     # The callee's 'arm' is a hand pose: it moved the fingers, not the arm.
     assert result.robot.trace[19]["index"] == pytest.approx(0.5)
     assert result.robot.trace[19]["arm"] == 1.0

@@ -11,7 +11,8 @@ Layout (entity paths):
   tensions (N).
 - ``tactile/<finger>``: the 16x16 depths (m), fingertip up, seen from the object.
 - ``events/log``: a text log of starts, ends, contacts, warnings and the criteria;
-  ``events/lanes/<event>``: ``running`` while a run of the event executes.
+  ``events/lanes/<event>``: ``running`` while a run of the event executes (a called script's
+  events: ``events/lanes/<script stem>.<event>``).
 
 Two timelines: ``sim_time`` (simulated time) and ``tick`` (the absolute tick).
 Body poses, joints, tensions and tactile images are sent as columns in batches of frames:
@@ -43,6 +44,7 @@ from dial.recording.geometry import (
     superquadric_mesh,
 )
 from dial.recording.timeline import describe, when
+from dial.scheduler.log import qualified_event
 
 APP_ID = "dial"
 TACTILE_RANGE = (0.0, 1e-3)  # m; a firm press is 0.5-1 mm deep
@@ -229,9 +231,9 @@ class RerunSink:
             rec.log("events/log", rr.TextLog(text, level=LEVELS[level]))
         kind = record["kind"]
         if kind == "start":
-            rec.log(f"events/lanes/{record['event']}", rr.StateChange(state="running"))
+            rec.log(f"events/lanes/{qualified_event(record)}", rr.StateChange(state="running"))
         elif kind == "end":
-            rec.log(f"events/lanes/{record['event']}", rr.StateChange.cleared())
+            rec.log(f"events/lanes/{qualified_event(record)}", rr.StateChange.cleared())
             self._sensed(record.get("data", {}))
         elif kind == "contact" and tips is not None:
             self._point("guards", tips[FINGERS.index(record["finger"])], (255, 80, 40))

@@ -12,6 +12,7 @@ from pathlib import Path
 from typing import Any
 
 from dial.errors import DialError
+from dial.scheduler.log import qualified_event
 
 Record = Mapping[str, Any]
 BAD_OUTCOMES = {"missed": "warn", "timeout": "error", "error": "error"}
@@ -61,17 +62,18 @@ def describe(record: Record) -> tuple[str, str] | None:
             "info",
         )
     if kind == "start":
-        return f"start {record['event']} (line {record['line']})", "info"
+        return f"start {qualified_event(record)} (line {record['line']})", "info"
     if kind == "end":
         outcome = record["outcome"]
         note = f": {record['message']}" if record.get("message") else ""
-        return f"end   {record['event']} {outcome}{note}", BAD_OUTCOMES.get(outcome, "info")
+        return f"end   {qualified_event(record)} {outcome}{note}", BAD_OUTCOMES.get(outcome, "info")
     if kind == "tick":
         if not record.get("stretch"):
             return None
         return f"tick {record['tick']} stretched by {record['stretch']} control periods", "info"
     if kind == "condition":
-        return f"condition {record['condition']} is {str(record['value']).lower()}", "info"
+        where = f" (in {Path(record['script']).name})" if record.get("script") else ""
+        return f"condition {record['condition']} is {str(record['value']).lower()}{where}", "info"
     if kind == "call":
         return f"call {record['script']}", "info"
     if kind == "contact":

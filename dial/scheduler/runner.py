@@ -211,7 +211,12 @@ class Runner:
         value = self.latest.get((script.path, cond.event)) is Outcome.DONE
         value = value != cond.negated
         self.log.write(
-            "condition", condition=str(cond), value=value, tick=self.tick, t=self.sim_time
+            "condition",
+            condition=str(cond),
+            value=value,
+            tick=self.tick,
+            t=self.sim_time,
+            **self._callee(script),
         )
         return value
 
@@ -310,8 +315,12 @@ class Runner:
             line=run.line,
             tick=self.tick,
             t=self.sim_time,
-            **({"script": script.path} if script.path != self._root else {}),
+            **self._callee(script),
         )
+
+    def _callee(self, script: Script) -> dict[str, str]:
+        """``script`` for the records of a called script's events: names repeat across files."""
+        return {"script": script.path} if script.path != self._root else {}
 
     # -- control periods ------------------------------------------------------------------------
     async def _period(self, stretched: bool) -> None:
@@ -370,6 +379,7 @@ class Runner:
             fields["message"] = ended.message
         if ended.data:
             fields["data"] = dict(ended.data)
+        fields.update(self._callee(script))
         self.log.write("end", event=run.event, line=run.line, tick=self.tick, t=t, **fields)
 
     def _aborted(self, script: Script, run: Run, ended: Ended) -> RunAborted:
