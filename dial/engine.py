@@ -86,6 +86,7 @@ class RunResult:
     physics_steps: int
     log: EventLog
     final_qpos: list[float] = field(default_factory=list)
+    cpu_time: float = 0.0  # s of this process's CPU over the same span as wall_time
 
     @property
     def ok(self) -> bool:
@@ -206,9 +207,9 @@ def run(script: Script, options: RunOptions) -> RunResult:
 
 
 def _run(script: Script, runner: Runner, robot: MujocoRobot, ctx: Context) -> RunResult:
-    start = time.perf_counter()
+    start, cpu = time.perf_counter(), time.process_time()
     summary = trio.run(runner.run, script)
-    wall = time.perf_counter() - start
+    wall, cpu = time.perf_counter() - start, time.process_time() - cpu
     success: dict[str, bool] = {}
     details: dict[str, str] = {}
     for criterion in ctx.world.criteria:
@@ -225,4 +226,5 @@ def _run(script: Script, runner: Runner, robot: MujocoRobot, ctx: Context) -> Ru
         robot.steps,
         runner.log,
         [float(x) for x in robot.data.qpos],
+        cpu,
     )

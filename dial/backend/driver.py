@@ -70,6 +70,10 @@ class MujocoRobot:
         self._saturated_since = np.full(32, -1.0)
         self._saturation_logged = np.zeros(32, dtype=bool)
         self._tactile_adr = [int(a) for a in ix.tactile_sensors]
+        # The four arrays' sensordata, in one fancy index: one copy per snapshot, not four.
+        self._tactile_idx = np.concatenate([np.arange(a, a + 256) for a in self._tactile_adr])
+        # Views of MuJoCo's warning counters, looked up once: they follow data.warning.
+        self._divergence = [data.warning[w] for w in _DIVERGENCE]
         arm_range = model.jnt_range[model.actuator_trnid[ix.arm_actuators, 0]]
         self._arm_lo = arm_range[:, 0] - LIMIT_SLACK
         self._arm_hi = arm_range[:, 1] + LIMIT_SLACK
@@ -139,8 +143,8 @@ class MujocoRobot:
 
     def tactile(self) -> FloatArray:
         """(4, 16, 16) taxel depths (m)."""
-        sd = self.data.sensordata
-        return np.stack([sd[a : a + 256] for a in self._tactile_adr]).reshape(4, 16, 16)
+        depths: FloatArray = self.data.sensordata[self._tactile_idx].reshape(4, 16, 16)
+        return depths
 
     def _apply(self) -> None:
         ix, d = self.index, self.data
@@ -210,8 +214,8 @@ class MujocoRobot:
         d, ix = self.data, self.index
         # MuJoCo resets the state itself when it meets a bad qacc/qpos/qvel, and counts a
         # warning: a nonzero count is the divergence (the state is no longer the run's).
-        for warning in _DIVERGENCE:
-            if d.warning[warning].number:
+        for warning in self._divergence:
+            if warning.number:
                 return "the physics diverged (MuJoCo reset an unstable state)"
         q = d.qpos[ix.arm_qpos]
         if ((q < self._arm_lo) | (q > self._arm_hi)).any():

@@ -1,12 +1,16 @@
 """Arm motion: VAL-II programs and commands (puma_command) and relative moves (arm_move).
 
 A motion is planned at its start as segments (joint-interpolated or straight
-line) and time-scaled over the run's executing ticks in tick time. Straight
-lines solve one IK waypoint per control period, warm-started.
+line) and time-scaled over the run's executing ticks in tick time. A straight
+line is solved at its start as IK waypoints a few mm apart, each warm-started
+from the one before; the arm moves between them in joint space. So the IK cost
+of a line depends on its length, not on its duration (a slow tick would
+otherwise solve one waypoint per control period).
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -20,6 +24,11 @@ from dial.scheduler.types import Ended, Now, RunInfo
 JOINT_SPEED = 1.0  # rad/s: nominal, only to share a run's time among its segments
 LINEAR_SPEED = 0.25  # m/s
 TURN_SPEED = 1.0  # rad/s
+# Waypoint spacing on a straight line. Between two waypoints the tool leaves the line by
+# about (step^2 / 8) times the path's curvature in joint space: micrometres here, well below
+# the IK tolerance (0.5 mm).
+LINE_STEP = 0.004  # m
+LINE_TURN_STEP = np.radians(2.0)  # rad
 
 
 def smooth(u: float) -> float:
@@ -47,12 +56,25 @@ def slerp(r0: FloatArray, r1: FloatArray, u: float) -> FloatArray:
 
 @dataclass(frozen=True)
 class Segment:
-    """One piece of an arm motion: joint-interpolated, or a straight tool line."""
+    """One piece of an arm motion: joint-interpolated, or a straight tool line.
+
+    ``waypoints`` (N + 1, 6): a line's joint configurations at u = k / N along it, from
+    ``q0`` to ``q1``; two rows (its ends) for a joint-interpolated segment.
+    """
 
     q0: FloatArray
     q1: FloatArray
-    line: tuple[FloatArray, FloatArray, FloatArray, FloatArray] | None  # p0, r0, p1, r1
+    waypoints: FloatArray
     cost: float
+
+    def at(self, u: float) -> FloatArray:
+        """The configuration at fraction ``u`` in [0, 1] of the segment."""
+        last = len(self.waypoints) - 1
+        x = min(1.0, max(0.0, u)) * last
+        k = min(int(x), last - 1)
+        a, b = self.waypoints[k], self.waypoints[k + 1]
+        out: FloatArray = a + (b - a) * (x - k)
+        return out
 
 
 class Planner:
@@ -64,15 +86,23 @@ class Planner:
 
     def joint_to(self, q1: FloatArray) -> None:
         cost = float(np.abs(q1 - self.q).max()) / JOINT_SPEED
-        self.segments.append(Segment(self.q, q1, None, cost))
+        self.segments.append(Segment(self.q, q1, np.stack([self.q, q1]), cost))
         self.q = q1
 
     def line_to(self, p1: FloatArray, r1: FloatArray, what: str) -> None:
-        p0, r0 = self.ctx.arm_ik.fk(self.q)
-        q1 = self.ctx.arm_ik.solve(p1, r1, self.q, what)
+        ik = self.ctx.arm_ik
+        p0, r0 = ik.fk(self.q)
+        q1 = ik.solve(p1, r1, self.q, what)
+        length = float(np.linalg.norm(p1 - p0))
         turn = float(np.arccos(np.clip((np.trace(r0.T @ r1) - 1.0) / 2.0, -1.0, 1.0)))
-        cost = max(float(np.linalg.norm(p1 - p0)) / LINEAR_SPEED, turn / TURN_SPEED)
-        self.segments.append(Segment(self.q, q1, (p0, r0, p1, r1), cost))
+        n = max(1, math.ceil(max(length / LINE_STEP, turn / LINE_TURN_STEP)))
+        waypoints = [self.q]
+        for k in range(1, n):
+            u = k / n
+            waypoints.append(ik.track(p0 + (p1 - p0) * u, slerp(r0, r1, u), waypoints[-1]))
+        waypoints.append(q1)
+        cost = max(length / LINEAR_SPEED, turn / TURN_SPEED)
+        self.segments.append(Segment(self.q, q1, np.stack(waypoints), cost))
         self.q = q1
 
     def statement(self, st: Statement, where: str) -> None:
@@ -125,15 +155,7 @@ class ArmMotion(RobotPrimitive):
         start = 0.0
         for seg, end in zip(self.segments, self.bounds, strict=True):
             if now.progress <= end + 1e-12 or seg is self.segments[-1]:
-                u = smooth((now.progress - start) / max(end - start, 1e-12))
-                if seg.line is None:
-                    self.q = seg.q0 + (seg.q1 - seg.q0) * u
-                else:
-                    p0, r0, p1, r1 = seg.line
-                    warm = self.q if u < 1.0 else seg.q1
-                    self.q = self.ctx.arm_ik.track(p0 + (p1 - p0) * u, slerp(r0, r1, u), warm)
-                    if u >= 1.0:
-                        self.q = seg.q1
+                self.q = seg.at(smooth((now.progress - start) / max(end - start, 1e-12)))
                 break
             start = end
         self.slots.arm(self.q)

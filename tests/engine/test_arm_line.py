@@ -1,0 +1,42 @@
+"""Straight arm lines (MOVES, DEPART, arm_move): waypoints solved at the start, on the line."""
+
+from __future__ import annotations
+
+from types import SimpleNamespace
+from typing import cast
+
+import numpy as np
+import pytest
+
+from dial.backend.ik import ArmIK
+from dial.backend.model import ARM_HOME
+from dial.primitives.arm import LINE_STEP, Planner, slerp
+from dial.primitives.context import Context, rpy_matrix
+
+
+@pytest.fixture(scope="module")
+def ik() -> ArmIK:
+    return ArmIK()
+
+
+def _angle(a: np.ndarray, b: np.ndarray) -> float:
+    return float(np.arccos(np.clip((np.trace(a.T @ b) - 1.0) / 2.0, -1.0, 1.0)))
+
+
+def test_the_tool_stays_on_the_line_between_waypoints(ik: ArmIK) -> None:
+    q0 = ik.solve(np.array([0.5, 0.0, 0.7]), rpy_matrix((np.pi, 0, 0)), np.array(ARM_HOME), "x")
+    planner = Planner(cast(Context, SimpleNamespace(arm_ik=ik)), q0)
+    p0, r0 = ik.fk(q0)
+    p1, r1 = p0 + np.array([0.10, 0.06, -0.12]), rpy_matrix((0, 0, np.radians(30))) @ r0
+    planner.line_to(p1, r1, "the goal")
+    (seg,) = planner.segments
+    length = float(np.linalg.norm(p1 - p0))
+    assert len(seg.waypoints) - 1 == int(np.ceil(length / LINE_STEP))  # 0.17 m: 43 steps
+    assert np.array_equal(seg.at(0.0), q0) and np.array_equal(seg.at(1.0), seg.q1)
+    worst_pos = worst_rot = 0.0
+    for u in np.linspace(0.0, 1.0, 401):  # between the waypoints too
+        pos, rot = ik.fk(seg.at(float(u)))
+        worst_pos = max(worst_pos, float(np.linalg.norm(pos - (p0 + (p1 - p0) * u))))
+        worst_rot = max(worst_rot, _angle(rot, slerp(r0, r1, float(u))))
+    assert worst_pos < 0.2e-3  # m (measured 0.05 mm; the ends alone would be cm off)
+    assert worst_rot < np.radians(0.1)
