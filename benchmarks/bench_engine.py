@@ -30,8 +30,8 @@ import numpy as np
 
 from dial.backend import driver
 from dial.backend.model import load_model
-from dial.engine import RunOptions, run
-from dial.parser import check_text, load
+from dial.engine import RunOptions, RunResult, run
+from dial.parser import Script, check_text, load
 from dial.resources import resolve_script
 from dial.scene import load_scene_names
 from dial.testing import run_fake
@@ -71,16 +71,21 @@ class _StepTimer(SimpleNamespace):
         self.mj_step = mj_step
 
 
+def _run_with(stand_in: object, script: Script) -> RunResult:
+    """Run ``script`` with ``stand_in`` as the driver's ``mujoco`` module."""
+    driver.mujoco = stand_in  # type: ignore[assignment]
+    try:
+        return run(script, RunOptions())
+    finally:
+        driver.mujoco = mujoco
+
+
 def engine_overhead(script_arg: str, repeat: int) -> None:
     script = load(resolve_script(script_arg), load_scene_names)
     # One recorded run gives the controls to replay; it is not timed (the recorder has its
     # own cost). Runs are deterministic, so every timed run steps the same physics.
     recorder = _StepRecorder()
-    driver.mujoco = recorder  # type: ignore[assignment]
-    try:
-        recorded = run(script, RunOptions())
-    finally:
-        driver.mujoco = mujoco
+    recorded = _run_with(recorder, script)
     model = load_model(recorded.world.model_path)
     data = mujoco.MjData(model)
     assert recorder.start is not None
@@ -98,11 +103,7 @@ def engine_overhead(script_arg: str, repeat: int) -> None:
     walls, replays, cpu_ratios, inside = [], [], [], []
     for _ in range(repeat):
         timer = _StepTimer()
-        driver.mujoco = timer  # type: ignore[assignment]
-        try:
-            result = run(script, RunOptions())
-        finally:
-            driver.mujoco = mujoco
+        result = _run_with(timer, script)
         inside.append(result.wall_time / timer.seconds)
         bare_wall, bare_cpu = replay()
         walls.append(result.wall_time)
