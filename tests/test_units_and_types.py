@@ -6,7 +6,15 @@ import math
 
 import pytest
 
-from dial.instructions.types import Conditions, Finger, MaskPair, ParamError, Quantity, mask_fingers
+from dial.instructions.types import (
+    Conditions,
+    Finger,
+    MaskPair,
+    ParamError,
+    Quantity,
+    mask_fingers,
+    parse_mask,
+)
 from dial.units import UnitError, parse_quantity
 
 
@@ -57,6 +65,20 @@ def test_paper_mask_pair() -> None:
 def test_bad_mask_pairs(text: str) -> None:
     with pytest.raises(ParamError):
         MaskPair().parse(text)
+
+
+@pytest.mark.parametrize(
+    ("text", "mask"), [("0x0666", 0x0666), ("0X00_0F", 0x000F), ("00666", 666), ("0x_1", 1)]
+)
+def test_masks_in_hex_or_decimal(text: str, mask: int) -> None:
+    assert parse_mask(text) == mask
+
+
+@pytest.mark.parametrize("text", ["0x", "0x__", "0x1g", "-1", "0x10000", "0"])
+def test_bad_masks_are_parameter_errors(text: str) -> None:
+    # A mutated script once reached int("00666", 0), which raised a bare ValueError.
+    with pytest.raises(ParamError):
+        parse_mask(text)
 
 
 def test_fingers_by_name_or_number() -> None:

@@ -92,7 +92,11 @@ def parse_mask(text: str) -> int:
     """A 16-bit joint mask, hex (``0x0666``) or decimal; never empty."""
     if not _MASK.match(text):
         raise ParamError(f"expected a 16-bit joint mask such as 0x0666, got '{text}'")
-    value = int(text.replace("_", ""), 0)
+    digits = text.replace("_", "")
+    hexa = digits[:2] in ("0x", "0X")
+    if hexa and len(digits) == 2:  # only underscores after 0x
+        raise ParamError(f"expected a 16-bit joint mask such as 0x0666, got '{text}'")
+    value = int(digits[2:], 16) if hexa else int(digits, 10)  # 00666 is decimal 666
     if value > ALL_JOINTS:
         raise ParamError(f"joint mask {text} has bits above bit 15; masks are 16 bits (0xFFFF)")
     if value == 0:
