@@ -16,6 +16,9 @@ _DIGITS = 6
 
 
 def _clean(value: Any) -> Any:
+    kind = type(value)
+    if kind is int or kind is str or kind is bool or value is None:  # most values: fast path
+        return value
     if isinstance(value, float):
         return round(value, _DIGITS) + 0.0  # +0.0 turns -0.0 into 0.0
     if isinstance(value, Mapping):

@@ -2,10 +2,10 @@
 
 One task, the driver, owns time. Every control period it hands each active run
 an immutable snapshot in a fixed order (start tick, line, mark), lets the robot
-advance, and ends runs whose step said so. Each run also has a trio task for
-its lifecycle (start, wait for its end, stop on end or cancellation); the
-driver waits for those tasks at fixed points, so trio's task order never
-reaches a result.
+advance, and ends runs whose step said so. The driver starts each run, in
+line order; the run's trio task then handles the rest of its lifecycle (wait
+for its end, stop on end or cancellation), and the driver waits for those
+tasks at fixed points, so trio's task order never reaches a result.
 """
 
 from __future__ import annotations
@@ -277,26 +277,30 @@ class Runner:
             timeout=float(timeout) if isinstance(timeout, int | float) else None,
         )
         self._write_start(script, run)
+        # Started here, in line order, not in the lifecycle task: no handshake with a new
+        # task per run (a trio round trip costs more than most starts).
+        try:
+            prim.start(self.robot.snapshot())
+        except DialError as e:
+            active.start_error = str(e)
+        except BaseException:
+            prim.stop()  # stop always runs, as it would in the lifecycle task
+            raise
         assert self._nursery is not None
-        await self._nursery.start(self._lifecycle, active)
+        self._nursery.start_soon(self._lifecycle, active)
         self.active.append(active)
         if active.start_error is not None:
             self._end(active, Ended(Outcome.ERROR, active.start_error), self.sim_time)
             await self._reap()
         return active
 
-    async def _lifecycle(
-        self, active: _Active, task_status: Any = trio.TASK_STATUS_IGNORED
-    ) -> None:
+    @staticmethod
+    async def _lifecycle(active: _Active) -> None:
+        """A started run's task: wait for its end, then stop it (always, also on cancel)."""
         try:
-            try:
-                active.prim.start(self.robot.snapshot())
-            except DialError as e:
-                active.start_error = str(e)
-            task_status.started()
             await active.end_signal.wait()
         finally:
-            active.prim.stop()  # always, also when cancelled
+            active.prim.stop()
             active.cleaned.set()
 
     def _instant(self, script: Script, run: Run, prim: Primitive, condition: bool) -> None:
