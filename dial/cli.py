@@ -116,6 +116,17 @@ def _progress(quiet: bool) -> Callable[[int, float, list[str]], None] | None:
     return show
 
 
+def _video_usage(path: str) -> None:
+    """A usage error (exit 2) if ``--video path`` cannot work here; EGL on headless Linux."""
+    if sys.platform.startswith("linux"):  # offscreen on the CPU; must precede `import mujoco`
+        os.environ.setdefault("MUJOCO_GL", "egl")
+    from dial.recording.video import video_problem
+
+    problem = video_problem(path)
+    if problem is not None:
+        raise UsageError(problem)
+
+
 def _check_watching(args: argparse.Namespace) -> None:
     """Usage errors (exit 2) and a missing display (exit 1), before the run starts."""
     if args.log_states and not args.log:
@@ -123,13 +134,7 @@ def _check_watching(args: argparse.Namespace) -> None:
     if args.record and Path(args.record).suffix.lower() != ".rrd":
         raise UsageError(f"--record writes a .rrd file, not '{args.record}'")
     if args.video:
-        if sys.platform.startswith("linux"):  # offscreen on the CPU; must precede `import mujoco`
-            os.environ.setdefault("MUJOCO_GL", "egl")
-        from dial.recording.video import video_problem
-
-        problem = video_problem(args.video)
-        if problem is not None:
-            raise UsageError(problem)
+        _video_usage(args.video)
     if args.rerun or args.viewer:
         from dial.recording.viewer import require_display
 
@@ -236,14 +241,21 @@ def cmd_replay(args: argparse.Namespace) -> int:
     from dial.recording.timeline import read_log, timeline
 
     path = Path(args.log)
+    if args.record and Path(args.record).suffix.lower() != ".rrd":
+        raise UsageError(f"--record writes a .rrd file, not '{args.record}'")
+    if args.video:
+        _video_usage(args.video)
     records = read_log(path)
     if args.record:
-        if Path(args.record).suffix.lower() != ".rrd":
-            raise UsageError(f"--record writes a .rrd file, not '{args.record}'")
         from dial.recording.replay import rebuild
 
         frames = rebuild(records, Path(args.record), f"{path.name} (replay)", path.parent)
         print(f"{args.record}: {frames} frames rebuilt from {path}", file=sys.stderr)
+    if args.video:
+        from dial.recording.replay import render_video
+
+        frames = render_video(records, Path(args.video), path.parent)
+        print(f"{args.video}: {frames} frames rendered from {path}", file=sys.stderr)
     sys.stdout.write(timeline(records))
     return 0
 
@@ -347,14 +359,20 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser(
         "replay",
-        help="print a run's timeline from its log, or rebuild its recording",
+        help="print a run's timeline from its log, or rebuild its recording or video",
         description="Print the timeline of a run from its --log: each event's start and end "
         "with tick, simulated time and outcome, contacts, conditions, messages and the "
-        "criteria. With --record, also rebuild a rerun recording from the log's states "
-        "(written by 'dial run --log FILE --log-states').",
+        "criteria. With --record or --video, also rebuild a rerun recording or a video from "
+        "the log's states (written by 'dial run --log FILE --log-states').",
     )
     p.add_argument("log", metavar="LOG.jsonl", help="a log written by 'dial run --log'")
     p.add_argument("--record", metavar="FILE.rrd", help="rebuild a rerun recording")
+    p.add_argument(
+        "--video",
+        metavar="FILE.mp4",
+        help="render the states to an .mp4 or .gif, one frame per state, from the camera of "
+        "'dial run --video' (needs the 'video' extra)",
+    )
     p.set_defaults(func=cmd_replay)
 
     p = sub.add_parser(

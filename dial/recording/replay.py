@@ -1,4 +1,5 @@
-"""``dial replay LOG --record OUT.rrd``: a recording rebuilt from a log's ``state`` records.
+"""``dial replay LOG --record OUT.rrd --video OUT.mp4``: a recording or a video rebuilt from
+a log's ``state`` records.
 
 A state (written with ``dial run --log FILE --log-states``) holds the whole ``qpos`` and the
 32 tendon tensions. Positions give everything else: body poses by forward kinematics, and
@@ -21,19 +22,19 @@ from dial.recording.frames import Frames
 from dial.recording.geometry import task_camera
 from dial.recording.observers import object_bodies
 from dial.recording.rerun_sink import RerunSink
+from dial.recording.video import VIDEO_FPS, Renderer, VideoFile
 from dial.scene.resolve import resolve_scene
-from dial.scene.world import load_world
+from dial.scene.world import World, load_world
 
 
-def rebuild(records: Sequence[dict[str, Any]], out: Path, title: str, base: Path) -> int:
-    """Write the run in ``records`` as a recording to ``out``; returns the number of frames.
-
-    ``base`` is where a scene given as a relative path resolves (the log's directory).
-    """
+def _replayed(
+    records: Sequence[dict[str, Any]], base: Path, what: str
+) -> tuple[World, mujoco.MjModel, mujoco.MjData, list[dict[str, Any]]]:
+    """The log's scene as it was during the run, at its first state, and its states."""
     states = [r for r in records if r["kind"] == "state"]
     if not states:
         raise DialError(
-            "the log holds no 'state' records to rebuild a recording from; "
+            f"the log holds no 'state' records to rebuild {what} from; "
             "run the script with --log FILE.jsonl --log-states"
         )
     scene = records[0]
@@ -51,11 +52,42 @@ def rebuild(records: Sequence[dict[str, Any]], out: Path, title: str, base: Path
         )
     data.qpos[:] = states[0]["qpos"]
     mujoco.mj_forward(model, data)
+    return world, model, data, states
+
+
+def rebuild(records: Sequence[dict[str, Any]], out: Path, title: str, base: Path) -> int:
+    """Write the run in ``records`` as a recording to ``out``; returns the number of frames.
+
+    ``base`` is where a scene given as a relative path resolves (the log's directory).
+    """
+    world, model, data, states = _replayed(records, base, "a recording")
     sink = RerunSink(out)
     try:
         _send(records, model, data, sink, title, list(world.objects.values()))
     finally:
         sink.close()
+    return len(states)
+
+
+def render_video(records: Sequence[dict[str, Any]], out: Path, base: Path) -> int:
+    """Render the log's states as a video to ``out`` (.mp4 or .gif), one frame per state,
+    from the camera of ``dial run --video``; returns the number of frames."""
+    world, model, data, states = _replayed(records, base, "a video")
+    times = [float(r["t"]) for r in states]
+    step = float(np.median(np.diff(times))) if len(times) > 1 else 1.0 / VIDEO_FPS
+    camera = task_camera(data, object_bodies(model, list(world.objects.values())))
+    renderer = Renderer(model, camera)
+    try:
+        writer = VideoFile(out, 1.0 / step)
+        try:
+            for state in states:
+                data.qpos[:] = state["qpos"]
+                mujoco.mj_forward(model, data)
+                writer.write(renderer.render(data))
+        finally:
+            writer.close()
+    finally:
+        renderer.close()
     return len(states)
 
 

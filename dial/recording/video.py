@@ -84,7 +84,7 @@ class VideoWriter:
         objects = object_bodies(model, list(run.world.objects.values()))
         self.renderer = Renderer(model, task_camera(data, objects))
         try:
-            self.writer = _Writer(self.path, fps)
+            self.writer = VideoFile(self.path, fps)
         except Exception:
             self.renderer.close()
             raise
@@ -102,7 +102,7 @@ class VideoWriter:
         self.renderer.close()
 
 
-class _Writer:
+class VideoFile:
     """imageio's ffmpeg writer (mp4) or its pillow writer (gif), behind one interface."""
 
     def __init__(self, path: Path, fps: float) -> None:

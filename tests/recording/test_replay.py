@@ -108,3 +108,14 @@ def test_bookkeeping_records_are_not_described() -> None:
 def test_a_summary_holds_a_tick_length_not_a_tick() -> None:
     assert when({"kind": "summary", "sim_time": 2.5, "tick": 0.25}, 7) == (2.5, 7)
     assert when({"kind": "tick", "tick": 3, "t0": 0.2, "t1": 0.3}, 2) == (0.3, 3)
+
+
+def test_replay_video_needs_a_known_format(
+    short_script: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    log = tmp_path / "run.jsonl"
+    log.write_text('{"kind":"scene","scene":"surface"}\n')
+    assert main(["replay", str(log), "--video", str(tmp_path / "run.avi")]) == 2
+    assert "--video writes .mp4 or .gif files, not '.avi'" in capsys.readouterr().err
+    assert main(["replay", str(log), "--video", str(tmp_path / "run.gif")]) == 1
+    assert "no 'state' records to rebuild a video from" in capsys.readouterr().err

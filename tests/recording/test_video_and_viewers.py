@@ -32,6 +32,7 @@ def test_video_is_rendered_at_a_steady_rate_of_simulated_time(
 
     video, log = tmp_path / "run.mp4", tmp_path / "run.jsonl"
     cmd = [*DIAL, "run", str(short_script), "--video", str(video), "--log", str(log), "--json"]
+    cmd.append("--log-states")
     done = subprocess.run(cmd, capture_output=True, text=True, env=_headless(), timeout=120)
     assert done.returncode in (0, 1), done.stderr  # 1: the surface criteria want a fit
     sim_time = json.loads(done.stdout.splitlines()[-1])["sim_time"]
@@ -41,6 +42,23 @@ def test_video_is_rendered_at_a_steady_rate_of_simulated_time(
     assert len(frames) == round(sim_time / 0.01) // round(100 / VIDEO_FPS) + 1
     assert frames[0].shape == (HEIGHT, WIDTH, 3)
     assert np.abs(frames[-1].astype(int) - frames[0].astype(int)).mean() > 1  # the arm moved
+
+    # dial replay --video renders the logged states (25 Hz, as the video) to the same film.
+    again = tmp_path / "replay.mp4"
+    cmd = [*DIAL, "replay", str(log), "--video", str(again)]
+    done = subprocess.run(cmd, capture_output=True, text=True, env=_headless(), timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert done.stderr.endswith(f"{again}: {len(frames)} frames rendered from {log}\n")
+    replayed = imageio.get_reader(again)
+    assert replayed.get_meta_data()["fps"] == VIDEO_FPS
+    shown = [np.asarray(f).astype(int) for f in replayed.iter_data()]
+    live = [f.astype(int) for f in frames]
+    same = [np.abs(a - b).mean() for a, b in zip(live, shown, strict=True)]
+    late = [np.abs(a - b).mean() for a, b in zip(live[1:], shown, strict=False)]
+    # The states hold positions to 0.1 mm, and both films are compressed: each picture
+    # differs by a few grey levels at most, and less than it does from the next frame.
+    assert max(same) < 2.0
+    assert np.mean(same) < np.mean(late)
 
 
 def test_video_needs_a_known_format_and_the_extra(monkeypatch: pytest.MonkeyPatch) -> None:
