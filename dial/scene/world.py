@@ -118,9 +118,9 @@ def load_world(path: Path) -> World:
     if "poses" in scene:
         shared = Path(reader.string(scene["poses"], "scene.poses"))
         poses.update(_shared_poses(reader, shared))
+    # The world file's poses win over the shared ones: a task tunes a standard pose (the
+    # paper's "prelight") for its object under the standard name.
     for name, table in reader.table(data.get("poses", {}), "poses").items():
-        if name in poses:
-            raise reader.error(f"poses.{name}", f"pose is already defined in {scene['poses']}")
         poses[name] = parse_pose(reader, name, table)
     locations = {
         name: _location(reader, name, value, objects)

@@ -62,7 +62,7 @@ def test_load_scene_names_reports_masks_locations_programs() -> None:
     names = load_scene_names("lightbulb", Path.cwd())
     assert names.name == "lightbulb"
     assert names.poses["prelight"] == 0xFFFF
-    assert names.poses["unscrew"] == 0x1111  # abduction only: the grip is kept
+    assert names.poses["unscrew"] == 0x1010  # middle and thumb abduction: the grip is kept
     assert names.poses["ungrasp"] == 0xEEEE
     assert names.poses["point_down"] == 0x000F
     assert "above_bulb" in names.locations
@@ -168,7 +168,6 @@ def _world(tmp_path: Path, body: str) -> Path:
         ('[programs]\np = "DEPART 5"', "distance 5 is out of range: expected -1 m to 1 m"),
         ('[programs]\np = "DEPART 3N"', "unit 'N' is not a length unit"),
         ('[programs]\np = "; nothing"', "programs.p: a program needs at least one statement"),
-        ("[poses.open_hand]\nindex = [0, 0, 0, 0]", "poses.open_hand: pose is already defined"),
         (
             "[poses.p]\npinky = [0, 0, 0, 0]",
             "poses.p.pinky: unknown key; valid keys: index, middle",
@@ -210,6 +209,16 @@ def test_toml_syntax_error_names_the_file(tmp_path: Path) -> None:
     path = write(tmp_path / "bad.toml", "[scene\n")
     with pytest.raises(WorldFileError, match=r"bad.toml: invalid TOML: .*line 1"):
         load_world(path)
+
+
+def test_a_world_pose_replaces_the_shared_one_of_that_name(tmp_path: Path) -> None:
+    shared = load_world(_world(tmp_path, "")).poses["prelight"]
+    mine = load_world(_world(tmp_path, "[poses.prelight]\nthumb = { abd = 7 }"))
+    assert mine.poses["prelight"].mask == 0x1000 != shared.mask
+    assert mine.poses["prelight"].angles[12] == pytest.approx(math.radians(7))
+    # The light-bulb task keeps the paper's names, with its own values.
+    bulb = load_world(worlds_dir() / "lightbulb.toml")
+    assert bulb.poses["unscrew"].mask == 0x1010 and shared.mask == 0xFFFF
 
 
 def test_missing_model_and_pose_file(tmp_path: Path) -> None:
