@@ -217,7 +217,7 @@ def cmd_run(args: argparse.Namespace) -> int:
 
 
 def _print_summary(result: Any, tick: float) -> None:
-    from dial.scheduler.log import qualified_event
+    from dial.recording.timeline import qualified_event
 
     s = result.summary
     rtf = s.sim_time / result.wall_time if result.wall_time > 0 else float("inf")
@@ -289,12 +289,13 @@ def cmd_tune(args: argparse.Namespace) -> int:
     return tune(options, ProcessExecutor(args.jobs))
 
 
-def _scene_argument(p: argparse.ArgumentParser, verb: str) -> None:
+def _scene_argument(p: argparse.ArgumentParser, checking: bool = False) -> None:
+    what = "check names against" if checking else "run in"
     p.add_argument(
         "--scene",
         metavar="NAME_OR_PATH",
-        help=f"{verb} in this scene instead of the script's @scene (the scripts it @calls "
-        "run in it too): a world file path, else a bundled scene name",
+        help=f"{what} this scene instead of the script's @scene (so do the scripts it "
+        "@calls): a world file path, else a bundled scene name",
     )
 
 
@@ -318,7 +319,7 @@ def build_parser() -> argparse.ArgumentParser:
         "error or a failed criterion, 130 on interrupt.",
     )
     p.add_argument("script", metavar="SCRIPT", help="script path or bundled name")
-    _scene_argument(p, "run")
+    _scene_argument(p)
     p.add_argument("--tick", type=float, metavar="S", help="tick length in s (default: @tick)")
     p.add_argument("--speed", type=float, default=1.0, metavar="F", help="divide the tick by F")
     p.add_argument("--seed", type=int, default=0, metavar="N", help="seed for --perturb")
@@ -382,7 +383,7 @@ def build_parser() -> argparse.ArgumentParser:
         "FILE:LINE:COL: message with the source line and a caret; exit 1 if any.",
     )
     p.add_argument("scripts", nargs="+", metavar="SCRIPT", help="script path or bundled name")
-    _scene_argument(p, "check")
+    _scene_argument(p, checking=True)
     p.set_defaults(func=cmd_check)
 
     p = sub.add_parser(
@@ -394,7 +395,7 @@ def build_parser() -> argparse.ArgumentParser:
         "every run with its executing and held ticks.",
     )
     p.add_argument("script", metavar="SCRIPT", help="script path or bundled name")
-    _scene_argument(p, "check")
+    _scene_argument(p, checking=True)
     p.set_defaults(func=cmd_show)
 
     p = sub.add_parser(
@@ -418,7 +419,7 @@ def build_parser() -> argparse.ArgumentParser:
         "plot could not be written), 2 on a usage error. See docs/tuning.md.",
     )
     p.add_argument("script", metavar="SCRIPT", help="script path or bundled name")
-    _scene_argument(p, "run")
+    _scene_argument(p)
     p.add_argument(
         "--ticks",
         required=True,

@@ -47,7 +47,18 @@ def test_check_and_show_take_a_scene(in_root: Path, capsys: pytest.CaptureFixtur
     assert main(["check", "scripts/explore.dial", "--scene", "pour"]) == 1
     out = capsys.readouterr().out
     assert "unknown program 'to_probe' in scene 'pour'" in out
-    assert "unknown program 'to_south' in scene 'pour', the caller's scene" in out
+    assert "unknown program 'to_south' in scene 'pour' (--scene replaces" in out
+
+
+def test_a_scene_that_does_not_load_is_reported_once(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    bad = tmp_path / "bad.toml"
+    bad.write_text('[scene]\nmodel = "nope.xml"\n[objects]\na = "b"\n')
+    # explore.dial calls two scripts: neither repeats the error, nor checks another scene.
+    assert main(["check", str(ROOT / "scripts" / "explore.dial"), "--scene", str(bad)]) == 1
+    out = capsys.readouterr().out
+    assert out.count("has a bad world file") == 1 and out.endswith("explore.dial: 1 error\n")
 
 
 def test_bundled_script_resolves_by_name(

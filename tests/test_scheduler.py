@@ -247,10 +247,13 @@ class _CtrlC(Primitive):
         return None
 
 
-def test_ctrl_c_stops_the_run_at_a_checkpoint_with_the_arm_held() -> None:
+@pytest.mark.parametrize("tick", [1, 3])  # also in the very first tick, before any period
+def test_ctrl_c_stops_the_run_at_a_checkpoint_with_the_arm_held(tick: int) -> None:
     # Ctrl-C during a native computation must not surface as whatever error that code makes
     # of a KeyboardInterrupt: the run ends as an interrupt (exit 130), logged, arm held.
-    script = check_text(ARM + HAND + "arm  #====\npose   #\n", "x.dial", origin=Path("x.dial"))
+    lane = " " * (tick - 1) + "#"
+    text = ARM + HAND + f"arm  #====\npose {lane}\n"
+    script = check_text(text, "x.dial", origin=Path("x.dial"))
     assert script is not None
     robot, log = FakeRobot(), EventLog()
     fake = FakeFactory(robot, {})
@@ -263,6 +266,7 @@ def test_ctrl_c_stops_the_run_at_a_checkpoint_with_the_arm_held() -> None:
         trio.run(runner.run, script, clock=trio.testing.MockClock(autojump_threshold=0))
     assert robot.held
     last = log.records[-1]
-    assert last["kind"] == "interrupted" and last["tick"] == 3
-    assert last["t"] == pytest.approx(0.2, abs=0.011)  # at most a period after the signal
+    assert last["kind"] == "interrupted" and last["tick"] == tick
+    start = (tick - 1) * 0.1
+    assert start <= last["t"] <= start + 0.011  # at most a period after the signal
     assert not [r for r in log.records if r["kind"] == "end"]  # the arm's move never finished

@@ -62,6 +62,14 @@ def _choices(valid: list[str]) -> str:
     return f" (valid: {', '.join(sorted(valid))})" if valid else " (none are defined)"
 
 
+class _SceneFailed:
+    """The caller's scene did not load (its error is reported): check no names in callees."""
+
+
+SCENE_FAILED = _SceneFailed()
+CallerScene = SceneNames | _SceneFailed | None
+
+
 class _Checker:
     def __init__(
         self,
@@ -72,7 +80,7 @@ class _Checker:
         diags: list[Diagnostic],
         origin: Path,
         scene_override: str | None,
-        caller_scene: SceneNames | None = None,
+        caller_scene: CallerScene = None,
     ) -> None:
         self.program = program
         self.scene_override = scene_override
@@ -85,6 +93,7 @@ class _Checker:
         self.events: dict[str, EventDef] = {}
         self.broken: set[str] = set()  # defined, but the definition has errors
         self.scene: SceneNames | None = None
+        self.scene_failed = False
 
     def error(self, span: Span, message: str, path: str | None = None) -> None:
         text = self.lines[span.line - 1] if 0 < span.line <= len(self.lines) else ""
@@ -110,6 +119,9 @@ class _Checker:
         )
 
     def load_scene(self) -> None:
+        if isinstance(self.caller_scene, _SceneFailed):
+            self.scene_failed = True
+            return
         if self.caller_scene is not None:
             self.scene = self.caller_scene
             return
@@ -122,8 +134,10 @@ class _Checker:
         try:
             self.scene = self.loader(text, self.origin.parent)
         except SceneNotFoundError as e:
+            self.scene_failed = True
             self.error(span, str(e))
         except ValueError as e:
+            self.scene_failed = True
             self.error(span, f"scene '{text}' has a bad world file: {e}")
 
     def define(self, d: Definition) -> None:
@@ -184,13 +198,17 @@ class _Checker:
 
     def written_for(self) -> str:
         """For a called script written for another scene: why its names are looked up here."""
-        own, caller = self.program.scene, self.caller_scene
+        own, caller = self.program.scene, self.scene
         if caller is None or own is None or Path(own.text).stem == caller.name:
             return ""
-        return (
-            f", the caller's scene (this script's own '@scene {own.text}' applies only when it "
-            "runs by itself)"
-        )
+        if self.scene_override is not None:
+            return f" (--scene replaces this script's own '@scene {own.text}')"
+        if isinstance(self.caller_scene, SceneNames):
+            return (
+                f", the caller's scene (this script's own '@scene {own.text}' applies only "
+                "when it runs by itself)"
+            )
+        return ""
 
     def diagram_events(self, body: tuple[Statement, ...]) -> set[str]:
         names: set[str] = set()
@@ -312,8 +330,9 @@ class _Checker:
             return None
         before = len(self.diags)
         display = str(Path(self.program.path).parent / stmt.target)
+        inherited: CallerScene = SCENE_FAILED if self.scene_failed else self.scene
         callee = check_file(
-            target, self.loader, self.stack, self.diags, display, self.scene_override, self.scene
+            target, self.loader, self.stack, self.diags, display, self.scene_override, inherited
         )
         if callee is None or len(self.diags) > before:
             return None
@@ -328,7 +347,7 @@ def check_text(
     diags: list[Diagnostic] | None = None,
     origin: Path | None = None,
     scene: str | None = None,
-    caller_scene: SceneNames | None = None,
+    caller_scene: CallerScene = None,
 ) -> Script | None:
     """Parse and check ``text``; append problems to ``diags`` (raise if ``diags`` is None).
 
@@ -336,7 +355,8 @@ def check_text(
     ``@call`` and ``@scene`` paths are relative to (default: ``path``). ``scene``, if
     given, replaces the ``@scene`` of this script and of every script it calls.
     ``caller_scene`` is the scene of the script that calls this one, if any: a called
-    script's names are checked against it, whatever its own ``@scene`` says.
+    script's names are checked against it, whatever its own ``@scene`` says
+    (:data:`SCENE_FAILED`: the caller's scene did not load, so no names are checked).
     """
     own = diags is None
     sink: list[Diagnostic] = [] if diags is None else diags
@@ -359,7 +379,7 @@ def check_file(
     diags: list[Diagnostic] | None = None,
     display: str | None = None,
     scene: str | None = None,
-    caller_scene: SceneNames | None = None,
+    caller_scene: CallerScene = None,
 ) -> Script | None:
     """Read, parse and check the script at ``path`` (``display`` is how errors name it)."""
     text = Path(path).read_text(encoding="utf-8", errors="replace")

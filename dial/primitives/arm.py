@@ -71,7 +71,10 @@ class Segment:
         """The configuration at fraction ``u`` in [0, 1] of the segment."""
         last = len(self.waypoints) - 1
         x = min(1.0, max(0.0, u)) * last
-        k = min(int(x), last - 1)
+        if x >= last:  # exactly the goal, as IK solved it (a + (b - a) * 1 may be a bit off)
+            end: FloatArray = self.waypoints[-1].copy()
+            return end
+        k = int(x)
         a, b = self.waypoints[k], self.waypoints[k + 1]
         out: FloatArray = a + (b - a) * (x - k)
         return out

@@ -43,8 +43,7 @@ from dial.recording.geometry import (
     shapes,
     superquadric_mesh,
 )
-from dial.recording.timeline import describe, when
-from dial.scheduler.log import qualified_event
+from dial.recording.timeline import describe, qualified_event, when
 
 APP_ID = "dial"
 TACTILE_RANGE = (0.0, 1e-3)  # m; a firm press is 0.5-1 mm deep

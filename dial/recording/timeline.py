@@ -12,7 +12,6 @@ from pathlib import Path
 from typing import Any
 
 from dial.errors import DialError
-from dial.scheduler.log import qualified_event
 
 Record = Mapping[str, Any]
 BAD_OUTCOMES = {"missed": "warn", "timeout": "error", "error": "error"}
@@ -49,6 +48,13 @@ def when(record: Record, tick: int) -> tuple[float, int]:
         return float(record.get("sim_time", 0.0)), tick
     t = record.get("t", record.get("t1", 0.0))
     return float(t), int(record.get("tick", tick))
+
+
+def qualified_event(record: Record) -> str:
+    """The event of a ``start`` or ``end`` record; a called script's events carry that
+    script's name (``explore_surface.reach``), since event names repeat across scripts."""
+    script = record.get("script")
+    return f"{Path(script).stem}.{record['event']}" if script else str(record["event"])
 
 
 def describe(record: Record) -> tuple[str, str] | None:

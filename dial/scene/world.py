@@ -105,7 +105,7 @@ _OPTIONAL_KEYS = ("poses", "locations", "programs", "criteria")
 def load_world(path: Path) -> World:
     """Load and validate a world file (following ``extends``)."""
     path = path.resolve()
-    data = _load_merged(path, ())
+    data, _ = _load_merged(path, ())
     reader = Reader(path)
     reader.keys(data, "", ["scene", "objects"], _OPTIONAL_KEYS)
     scene = reader.table(data["scene"], "scene")
@@ -234,13 +234,15 @@ def _name(reader: Reader, table: str, name: str) -> str:
     return name
 
 
-def _load_merged(path: Path, seen: tuple[Path, ...]) -> dict[str, Any]:
-    """The file's data with ``extends`` applied: tables merge key by key, the child winning.
+def _load_merged(path: Path, seen: tuple[Path, ...]) -> tuple[dict[str, Any], frozenset[Path]]:
+    """The file's data with ``extends`` applied, and every file that went into it.
 
-    ``extends`` names one world file or a list of them. Bases merge in order; a key that two
-    bases set differently is an error unless the child sets it too (a silent winner would
-    hide which definition a script gets). Paths in ``[scene]`` are made absolute against the
-    file that wrote them, so a world file may extend one in another directory (or a bundled
+    Tables merge entry by entry, the child winning. ``extends`` names one world file or a
+    list of them, merged in order. An entry that two bases set differently is an error
+    unless the child sets it too, or the later base extends the earlier one (a refinement):
+    a silent winner would hide which definition a script gets. ``[scene] description`` is
+    only text and never conflicts. Paths in ``[scene]`` are made absolute against the file
+    that wrote them, so a world file may extend one in another directory (or a bundled
     scene, by name).
     """
     reader = Reader(path)
@@ -254,23 +256,25 @@ def _load_merged(path: Path, seen: tuple[Path, ...]) -> dict[str, Any]:
             if isinstance(scene.get(key), str):
                 scene[key] = str((path.parent / scene[key]).resolve())
     if "extends" not in data:
-        return data
+        return data, frozenset({path})
     value = data.pop("extends")
     names = [value] if isinstance(value, str) else value
     if not isinstance(names, list) or not names or not all(isinstance(n, str) for n in names):
         raise reader.error("extends", "expected a world file (name or path) or a list of them")
     merged: dict[str, Any] = {}
-    setter: dict[tuple[str, ...], Path] = {}  # each base key -> the base that set it
+    files = {path}
+    setter: dict[tuple[str, ...], Path] = {}  # each base entry -> the base that set it
     mine = _leaves(data)
     for name in names:
         try:
             base_path = resolve_scene(name, path.parent).resolve()
         except LookupError as e:
             raise reader.error("extends", str(e)) from None
-        base = _load_merged(base_path, (*seen, path))
-        theirs, before = _leaves(base), _leaves(merged)
-        for entry, leaf in theirs.items():
-            if entry in before and before[entry] != leaf and entry not in mine:
+        base, ancestry = _load_merged(base_path, (*seen, path))
+        before = _leaves(merged)
+        for entry, leaf in _leaves(base).items():
+            clash = entry in before and before[entry] != leaf and entry not in mine
+            if clash and entry != ("scene", "description") and setter[entry] not in ancestry:
                 raise reader.error(
                     ".".join(entry),
                     f"set differently by {setter[entry].name} and {base_path.name}; "
@@ -278,7 +282,8 @@ def _load_merged(path: Path, seen: tuple[Path, ...]) -> dict[str, Any]:
                 )
             setter[entry] = base_path
         merged = _merge(merged, base)
-    return _merge(merged, data)
+        files |= ancestry
+    return _merge(merged, data), frozenset(files)
 
 
 def _leaves(data: Mapping[str, Any]) -> dict[tuple[str, ...], Any]:

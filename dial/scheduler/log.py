@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import json
 from collections.abc import Mapping
-from pathlib import Path
 from typing import IO, Any
 
 _DIGITS = 6
@@ -28,13 +27,6 @@ def _clean(value: Any) -> Any:
     if hasattr(value, "tolist"):  # numpy arrays and scalars
         return _clean(value.tolist())
     return value
-
-
-def qualified_event(record: Mapping[str, Any]) -> str:
-    """The event of a ``start`` or ``end`` record; a called script's events carry that
-    script's name (``explore_surface.reach``), since event names repeat across scripts."""
-    script = record.get("script")
-    return f"{Path(script).stem}.{record['event']}" if script else str(record["event"])
 
 
 class EventLog:

@@ -126,7 +126,8 @@ class Runner:
             async with trio.open_nursery() as nursery:
                 self._nursery = nursery
                 if threading.current_thread() is threading.main_thread():
-                    nursery.start_soon(self._await_interrupt, nursery.cancel_scope, signalled)
+                    # Listening before the first run starts (its start may solve IK for long).
+                    await nursery.start(self._await_interrupt, nursery.cancel_scope, signalled)
                 try:
                     await self._steps(script, script.timeline)
                 except RunAborted as e:
@@ -155,13 +156,16 @@ class Runner:
         )
 
     @staticmethod
-    async def _await_interrupt(scope: trio.CancelScope, signalled: list[bool]) -> None:
+    async def _await_interrupt(
+        scope: trio.CancelScope, signalled: list[bool], task_status: Any = trio.TASK_STATUS_IGNORED
+    ) -> None:
         """Turn Ctrl-C into a cancellation at the next checkpoint.
 
         Left to trio, the KeyboardInterrupt is raised wherever the main thread happens to
         be, e.g. inside a native IK solve, which can turn it into an unrelated error.
         """
         with trio.open_signal_receiver(signal.SIGINT) as signals:
+            task_status.started()
             async for _ in signals:
                 signalled.append(True)
                 scope.cancel()

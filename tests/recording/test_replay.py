@@ -113,6 +113,7 @@ def test_a_summary_holds_a_tick_length_not_a_tick() -> None:
 def test_replay_video_needs_a_known_format(
     short_script: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
+    pytest.importorskip("imageio", reason="the 'video' extra is not installed")
     log = tmp_path / "run.jsonl"
     log.write_text('{"kind":"scene","scene":"surface"}\n')
     assert main(["replay", str(log), "--video", str(tmp_path / "run.avi")]) == 2

@@ -281,6 +281,14 @@ def test_extends_a_list_rejects_a_name_two_bases_define_differently(tmp_path: Pa
         f'extends = ["{base}", "p.toml", "q.toml"]\n[programs]\nback = "DEPART 0.3"\n',
     )
     assert load_world(chosen).programs["back"].statements == (Depart(1, 0.3),)
+    # A base that extends an earlier one refines it: no conflict, the later one wins.
+    write(tmp_path / "r.toml", 'extends = "p.toml"\n[programs]\nback = "DEPART 0.4"')
+    refined = write(tmp_path / "refined.toml", f'extends = ["{base}", "p.toml", "r.toml"]\n')
+    assert load_world(refined).programs["back"].statements == (Depart(1, 0.4),)
+    # Descriptions are only text.
+    write(tmp_path / "d1.toml", '[scene]\ndescription = "one"')
+    write(tmp_path / "d2.toml", '[scene]\ndescription = "two"')
+    load_world(write(tmp_path / "ds.toml", f'extends = ["{base}", "d1.toml", "d2.toml"]\n'))
     for bad in ("[]", "3", '["p.toml", 3]'):
         path = write(tmp_path / "bad.toml", f"extends = {bad}\n")
         with pytest.raises(WorldFileError, match="extends: expected a world file"):
