@@ -25,7 +25,7 @@ from dial.parser.check import Script
 from dial.primitives import Context, make_factory
 from dial.primitives.context import location_pose, rpy_matrix
 from dial.scene.evaluate import measure
-from dial.scene.resolve import resolve_scene
+from dial.scene.resolve import resolve_scene, worlds_dir
 from dial.scene.world import World, load_world
 from dial.scheduler.log import EventLog
 from dial.scheduler.runner import Runner, RunSummary
@@ -165,9 +165,11 @@ def prepare(script: Script, options: RunOptions, log: EventLog) -> tuple[MujocoR
     mujoco.mj_forward(model, data)
     for _ in range(round(SETTLE_S / model.opt.timestep)):
         mujoco.mj_step(model, data)
-    log.write(
-        "scene", scene=world.name, world=str(world.path.name), perturb=shift, seed=options.seed
-    )
+    # A bundled world by its file name; another by its absolute path, so that dial replay
+    # finds it from anywhere.
+    bundled = world.path.parent == worlds_dir().resolve()
+    where = world.path.name if bundled else str(world.path)
+    log.write("scene", scene=world.name, world=where, perturb=shift, seed=options.seed)
     robot = MujocoRobot(model, data, log)
     return robot, Context(robot, world, believed, ik)
 

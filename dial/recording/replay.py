@@ -38,7 +38,11 @@ def _replayed(
             "run the script with --log FILE.jsonl --log-states"
         )
     scene = records[0]
-    world = load_world(resolve_scene(str(scene["scene"]), base))
+    path = Path(str(scene.get("world", "")))
+    # A world that is not bundled is logged by its absolute path.
+    world = load_world(
+        path if path.is_absolute() and path.is_file() else resolve_scene(str(scene["scene"]), base)
+    )
     model = load_model(world.model_path)
     data = mujoco.MjData(model)
     for name in world.objects.values():  # --perturb moved the fixed objects in the model

@@ -80,3 +80,21 @@ def test_a_script_without_scene_names_the_option(
     script = _write(tmp_path / "s.dial", "% wrist get_wrist\n\nwrist #\n")
     assert main(["run", str(script)]) == 1
     assert "add '@scene NAME' or run it with --scene" in capsys.readouterr().err
+
+
+def test_a_run_in_a_world_file_of_ones_own_replays_from_anywhere(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    mine = tmp_path / "worlds"
+    mine.mkdir()
+    world = _write(mine / "my_cylinder.toml", 'extends = "containment_cylinder"\n')
+    script = _write(tmp_path / "s.dial", "@tick 0.05\n% wrist get_wrist\n\nwrist #\n")
+    log, rrd = tmp_path / "logs" / "log.jsonl", tmp_path / "out.rrd"
+    log.parent.mkdir()
+    args = ["run", str(script), "--scene", str(world), "--quiet", "--log", str(log)]
+    assert main([*args, "--log-states"]) == 1
+    scene, _ = _records(log)
+    assert scene["scene"] == "my_cylinder" and scene["world"] == str(world.resolve())
+    monkeypatch.chdir(tmp_path / "logs")  # neither here nor beside the log: found by its path
+    assert main(["replay", str(log), "--record", str(rrd)]) == 0
+    assert rrd.stat().st_size > 0
