@@ -2,9 +2,13 @@
 
 The grasp must make up a bulb that is not where the world model believes: with seed 4 the
 offset is one that made the paper's index-middle-ring grip curl under the glass and jam.
+At 10 mm, seeds 1, 6 and 7 lost the freed bulb from an off-centre pinch until the script
+learnt to feel for the glass and centre over it before grasping.
 """
 
 from __future__ import annotations
+
+import pytest
 
 from dial.engine import RunOptions, run
 from dial.parser import load
@@ -22,3 +26,18 @@ def test_lightbulb_comes_out_held_when_5mm_off() -> None:
     (released,) = result.log.of("thread")
     last_grasp = result.log.of("start")[-4]
     assert last_grasp["event"] == "grasp_bulb" and released["t"] > last_grasp["t"]
+
+
+@pytest.mark.parametrize("seed", [1, 6, 7])
+def test_lightbulb_centres_on_the_glass_by_touch_when_10mm_off(seed: int) -> None:
+    script = load(ROOT / "scripts" / "lightbulb.dial", load_scene_names)
+    result = run(script, RunOptions(perturb_mm=10.0, seed=seed))
+    assert result.summary.ok, result.summary.error
+    assert result.success == {"bulb_out": True, "bulb_held": True}, result.details
+    # Two touches of the thumb, one per horizontal axis, each stopped by its tendon force.
+    feels = [r for r in result.log.of("end") if r["event"] == "feel_glass"]
+    assert [(r["outcome"], r["data"]["kind"], r["data"]["finger"]) for r in feels] == [
+        ("done", "force", "thumb")
+    ] * 2
+    # The travel to the touch is the believed one (about 17-20 mm) plus the offset along it.
+    assert all(0.005 < r["data"]["travel"] < 0.035 for r in feels)
