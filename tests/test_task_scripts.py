@@ -27,30 +27,33 @@ def test_show_chart_is_pinned(name: str, in_root: Path, capsys: pytest.CaptureFi
 def test_lightbulb_tick_ranges_follow_the_paper() -> None:
     runs = _ranges("lightbulb.dial")
     assert runs[:2] == [("to_bulb", 1, 10), ("preshape", 6, 10)]
-    # Added to the paper's script: feel for the glass along two axes and centre over it.
-    assert runs[2:8] == [
-        ("feel_glass", 11, 11),
-        ("centre_y", 12, 14),
-        ("turn_probe", 15, 20),
-        ("feel_glass", 21, 21),
-        ("centre_x", 22, 24),
-        ("turn_back", 25, 30),
+    # Added to the paper's script: feel for the glass along two axes and centre over it,
+    # each time once the thumb is at rest (a while loop: shown once, run zero or more times).
+    assert runs[2:10] == [
+        ("settle", 11, 11),
+        ("feel_glass", 12, 12),
+        ("centre_y", 13, 15),
+        ("turn_probe", 16, 21),
+        ("settle", 22, 22),
+        ("feel_glass", 23, 23),
+        ("centre_x", 24, 26),
+        ("turn_back", 27, 32),
     ]
     first_iteration = [
-        ("grasp_bulb", 31, 31),
-        ("twist_hand", 32, 40),
-        ("twist_armCCW", 32, 40),
-        ("ungrasp", 41, 43),
-        ("preshape", 44, 50),
-        ("twist_armCW", 44, 50),
+        ("grasp_bulb", 33, 33),
+        ("twist_hand", 34, 42),
+        ("twist_armCCW", 34, 42),
+        ("ungrasp", 43, 45),
+        ("preshape", 46, 52),
+        ("twist_armCW", 46, 52),
     ]
     # Every repeated iteration is the same 20 ticks, shifted.
-    iterations = (len(runs) - 8 - 4) // 6
+    iterations = (len(runs) - 10 - 4) // 6
     assert iterations >= 2
     for i in range(iterations):
         shifted = [(e, s + 20 * i, h + 20 * i) for e, s, h in first_iteration]
-        assert runs[8 + 6 * i : 14 + 6 * i] == shifted
-    last = 30 + 20 * iterations
+        assert runs[10 + 6 * i : 16 + 6 * i] == shifted
+    last = 32 + 20 * iterations
     assert runs[-4:] == [
         ("grasp_bulb", last + 1, last + 1),
         ("twist_hand", last + 2, last + 10),
