@@ -58,22 +58,25 @@ def slerp(r0: FloatArray, r1: FloatArray, u: float) -> FloatArray:
 class Segment:
     """One piece of an arm motion: joint-interpolated, or a straight tool line.
 
-    ``waypoints`` (N + 1, 6): a line's joint configurations at u = k / N along it, from
-    ``q0`` to ``q1``; two rows (its ends) for a joint-interpolated segment.
+    ``waypoints`` (N + 1, 6): a line's joint configurations at u = k / N along it, from its
+    start to its goal; two rows (its ends) for a joint-interpolated segment.
     """
 
-    q0: FloatArray
-    q1: FloatArray
     waypoints: FloatArray
     cost: float
+
+    @property
+    def q1(self) -> FloatArray:
+        """The goal configuration, as IK solved it."""
+        goal: FloatArray = self.waypoints[-1]
+        return goal
 
     def at(self, u: float) -> FloatArray:
         """The configuration at fraction ``u`` in [0, 1] of the segment."""
         last = len(self.waypoints) - 1
         x = min(1.0, max(0.0, u)) * last
-        if x >= last:  # exactly the goal, as IK solved it (a + (b - a) * 1 may be a bit off)
-            end: FloatArray = self.waypoints[-1].copy()
-            return end
+        if x >= last:  # exactly the goal (a + (b - a) * 1 may be a bit off)
+            return self.q1.copy()
         k = int(x)
         a, b = self.waypoints[k], self.waypoints[k + 1]
         out: FloatArray = a + (b - a) * (x - k)
@@ -89,7 +92,7 @@ class Planner:
 
     def joint_to(self, q1: FloatArray) -> None:
         cost = float(np.abs(q1 - self.q).max()) / JOINT_SPEED
-        self.segments.append(Segment(self.q, q1, np.stack([self.q, q1]), cost))
+        self.segments.append(Segment(np.stack([self.q, q1]), cost))
         self.q = q1
 
     def line_to(self, p1: FloatArray, r1: FloatArray, what: str) -> None:
@@ -105,7 +108,7 @@ class Planner:
             waypoints.append(ik.track(p0 + (p1 - p0) * u, slerp(r0, r1, u), waypoints[-1]))
         waypoints.append(q1)
         cost = max(length / LINEAR_SPEED, turn / TURN_SPEED)
-        self.segments.append(Segment(self.q, q1, np.stack(waypoints), cost))
+        self.segments.append(Segment(np.stack(waypoints), cost))
         self.q = q1
 
     def statement(self, st: Statement, where: str) -> None:
