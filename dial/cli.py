@@ -116,6 +116,12 @@ def _progress(quiet: bool) -> Callable[[int, float, list[str]], None] | None:
     return show
 
 
+def _record_usage(path: str) -> None:
+    """A usage error (exit 2) if ``--record path`` is not a rerun file."""
+    if Path(path).suffix.lower() != ".rrd":
+        raise UsageError(f"--record writes a .rrd file, not '{path}'")
+
+
 def _video_usage(path: str) -> None:
     """A usage error (exit 2) if ``--video path`` cannot work here; EGL on headless Linux."""
     if sys.platform.startswith("linux"):  # offscreen on the CPU; must precede `import mujoco`
@@ -131,8 +137,8 @@ def _check_watching(args: argparse.Namespace) -> None:
     """Usage errors (exit 2) and a missing display (exit 1), before the run starts."""
     if args.log_states and not args.log:
         raise UsageError("--log-states writes into the log: give --log FILE.jsonl too")
-    if args.record and Path(args.record).suffix.lower() != ".rrd":
-        raise UsageError(f"--record writes a .rrd file, not '{args.record}'")
+    if args.record:
+        _record_usage(args.record)
     if args.video:
         _video_usage(args.video)
     if args.rerun or args.viewer:
@@ -241,8 +247,8 @@ def cmd_replay(args: argparse.Namespace) -> int:
     from dial.recording.timeline import read_log, timeline
 
     path = Path(args.log)
-    if args.record and Path(args.record).suffix.lower() != ".rrd":
-        raise UsageError(f"--record writes a .rrd file, not '{args.record}'")
+    if args.record:
+        _record_usage(args.record)
     if args.video:
         _video_usage(args.video)
     records = read_log(path)
