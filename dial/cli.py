@@ -17,8 +17,9 @@ from typing import Any
 from dial import __version__
 from dial.errors import DialError, ScriptError
 from dial.instructions.scene_names import SceneLoader
-from dial.parser.check import Script, load
+from dial.parser.check import load
 from dial.parser.fmt import format_text
+from dial.parser.script import Script
 from dial.parser.show import render
 from dial.parser.timeline import expand
 from dial.resources import resolve_script
@@ -43,7 +44,7 @@ def _scene_loader() -> SceneLoader:
 
 
 def _load(arg: str, scene: str | None = None) -> Script:
-    return load(resolve_script(arg), _scene_loader(), scene=scene)
+    return load(resolve_script(arg), loader=_scene_loader(), scene=scene)
 
 
 def _scene_option(arg: str | None) -> str | None:

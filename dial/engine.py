@@ -21,7 +21,7 @@ from dial.backend.driver import MujocoRobot
 from dial.backend.ik import ArmIK
 from dial.backend.model import ARM_HOME, RobotIndex, hand_ctrl, load_model
 from dial.errors import DialError
-from dial.parser.check import Script
+from dial.parser.script import Script
 from dial.primitives import Context, make_factory
 from dial.primitives.context import location_pose, rpy_matrix
 from dial.scene.evaluate import measure

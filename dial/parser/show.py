@@ -6,7 +6,7 @@ A pure function from a checked script to text.
 from __future__ import annotations
 
 from dial.instructions.types import EFFECTORS
-from dial.parser.check import Script
+from dial.parser.script import Script
 from dial.parser.timeline import Layout, Placed, expand
 
 

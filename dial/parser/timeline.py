@@ -1,79 +1,14 @@
-"""The compiled timeline: every run with its block, start tick, executing and held ticks.
+"""The timeline laid out for display: every run placed on absolute ticks.
 
-Ticks here are block ticks (1-based). :func:`expand` lays the whole script out
-on absolute ticks for display, expanding counted repeats and calls.
+:func:`expand` lays a whole checked script out, expanding counted repeats and calls.
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterator
-from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Literal
+from dataclasses import dataclass
 
-from dial.errors import Span
-from dial.parser.ast import Condition
-
-if TYPE_CHECKING:
-    from dial.parser.check import Script
-
-
-@dataclass(frozen=True)
-class Run:
-    """One run of an event inside a block.
-
-    The run executes in ticks ``start..exec_end`` and is held (its effectors
-    keep the final command, still reserved) in ``exec_end+1..hold_end``.
-    """
-
-    event: str
-    line: int
-    start: int
-    exec_end: int
-    hold_end: int
-    effectors: frozenset[str]
-    span: Span = field(default=Span(0, 0, 0), compare=False)  # the run's marks in the diagram
-
-    @property
-    def executing(self) -> range:
-        return range(self.start, self.exec_end + 1)
-
-    @property
-    def held(self) -> range:
-        return range(self.exec_end + 1, self.hold_end + 1)
-
-
-@dataclass(frozen=True)
-class TBlock:
-    line: int
-    length: int
-    runs: tuple[Run, ...]  # ordered by start tick, then line: the order runs start in
-
-
-@dataclass(frozen=True)
-class TRepeat:
-    kind: Literal["count", "until", "while"]
-    count: int  # the repeat count, or the loop limit ("max") of until/while
-    condition: Condition | None
-    body: tuple[Step, ...]
-    line: int
-
-
-@dataclass(frozen=True)
-class TIf:
-    condition: Condition
-    then: tuple[Step, ...]
-    orelse: tuple[Step, ...]
-    line: int
-
-
-@dataclass(frozen=True)
-class TCall:
-    target: str
-    script: Script
-    line: int
-
-
-Step = TBlock | TRepeat | TIf | TCall
+from dial.parser.script import Run, Script, Step, TBlock, TIf, TRepeat
 
 
 @dataclass(frozen=True)

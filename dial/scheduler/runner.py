@@ -22,8 +22,7 @@ import trio
 
 from dial.errors import DialError
 from dial.parser.ast import Condition
-from dial.parser.check import Script
-from dial.parser.timeline import Run, Step, TBlock, TCall, TIf, TRepeat
+from dial.parser.script import Run, Script, Step, TBlock, TCall, TIf, TRepeat
 from dial.scheduler.log import EventLog
 from dial.scheduler.types import (
     Ended,

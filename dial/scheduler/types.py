@@ -13,8 +13,7 @@ from enum import StrEnum
 from typing import Any, Protocol
 
 from dial.errors import DialError
-from dial.parser.check import EventDef
-from dial.parser.timeline import Run
+from dial.parser.script import EventDef, Run
 
 
 class Outcome(StrEnum):

@@ -11,7 +11,6 @@ from __future__ import annotations
 import itertools
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
-from pathlib import Path
 from types import MappingProxyType
 from typing import Any
 
@@ -19,7 +18,8 @@ import trio
 import trio.testing
 
 from dial.instructions.types import EFFECTORS
-from dial.parser.check import Script, check_text
+from dial.parser.check import check_text
+from dial.parser.script import Script
 from dial.scheduler.log import EventLog
 from dial.scheduler.runner import Runner, RunSummary
 from dial.scheduler.types import Ended, InstantPrimitive, Now, Outcome, Primitive, RunInfo
@@ -164,7 +164,7 @@ def run_fake(
 ) -> FakeResult:
     """Check ``script`` (text or checked script) and run it on a fake robot, on virtual time."""
     if isinstance(script, str):
-        checked = check_text(script, path, origin=Path(path))
+        checked = check_text(script, path)
         assert checked is not None
         script = checked
     robot = FakeRobot(period, fault_at)

@@ -19,7 +19,8 @@ import trio
 import trio.testing
 
 from dial.instructions.types import EFFECTORS
-from dial.parser.check import Script, load
+from dial.parser.check import load
+from dial.parser.script import Script
 from dial.scheduler.log import EventLog
 from dial.scheduler.runner import Runner, RunSummary
 from dial.testing.fake import FakeFactory, FakeRobot

@@ -18,7 +18,9 @@ from dial.scene import load_scene_names
 
 def _run(path: Path, perturb: float = 0.0) -> tuple[str, list[float]]:
     sink = io.StringIO()
-    result = run(load(path, load_scene_names), RunOptions(log=sink, perturb_mm=perturb, seed=7))
+    result = run(
+        load(path, loader=load_scene_names), RunOptions(log=sink, perturb_mm=perturb, seed=7)
+    )
     return sink.getvalue(), result.final_qpos
 
 

@@ -75,7 +75,7 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> tuple[engine.RunResult, Rec
 
     engine.MujocoRobot = Capture  # type: ignore[misc]
     try:
-        result = engine.run(load(path, load_scene_names), engine.RunOptions())
+        result = engine.run(load(path, loader=load_scene_names), engine.RunOptions())
     finally:
         engine.MujocoRobot = original  # type: ignore[misc]
     return result, robots[0]

@@ -1,0 +1,119 @@
+"""Compile a checked program's execution part into the timeline, and find effector conflicts.
+
+The compiler walks the statements once. What it needs to know about names (the bound
+event of an execution line, whether a condition is valid, the script a ``@call`` names) it
+asks the checker through :class:`Checks`, which also collects the problems.
+"""
+
+from __future__ import annotations
+
+from typing import Protocol
+
+from dial.errors import Span
+from dial.instructions.types import FINGERS
+from dial.parser.ast import Block, Call, Condition, ExecLine, If, Repeat, Statement
+from dial.parser.script import EventDef, Run, Script, Step, TBlock, TCall, TIf, TRepeat
+
+
+class Checks(Protocol):
+    """The checker's side of compilation."""
+
+    def error(self, span: Span, message: str) -> None:
+        """Report a problem."""
+
+    def event(self, line: ExecLine) -> EventDef | None:
+        """The bound event of an execution line, or None (its problem is reported)."""
+
+    def condition(self, cond: Condition | None) -> None:
+        """Check a condition of ``@if`` or ``@repeat``."""
+
+    def call(self, stmt: Call) -> Script | None:
+        """The checked callee of a ``@call``, or None (its problems are reported)."""
+
+
+def diagram_events(body: tuple[Statement, ...]) -> set[str]:
+    """The events that appear on an execution line of ``body``."""
+    names: set[str] = set()
+    for stmt in body:
+        if isinstance(stmt, Block):
+            names.update(line.event for line in stmt.lines)
+        elif isinstance(stmt, Repeat):
+            names |= diagram_events(stmt.body)
+        elif isinstance(stmt, If):
+            names |= diagram_events(stmt.then) | diagram_events(stmt.orelse)
+    return names
+
+
+def compile_body(body: tuple[Statement, ...], checks: Checks) -> tuple[Step, ...]:
+    """The timeline of ``body``."""
+    steps: list[Step] = []
+    for stmt in body:
+        if isinstance(stmt, Block):
+            steps.append(compile_block(stmt, checks))
+        elif isinstance(stmt, Repeat):
+            checks.condition(stmt.condition)
+            inner = compile_body(stmt.body, checks)
+            steps.append(TRepeat(stmt.kind, stmt.count, stmt.condition, inner, stmt.line))
+        elif isinstance(stmt, If):
+            checks.condition(stmt.condition)
+            then, orelse = compile_body(stmt.then, checks), compile_body(stmt.orelse, checks)
+            steps.append(TIf(stmt.condition, then, orelse, stmt.line))
+        else:
+            callee = checks.call(stmt)
+            if callee is not None:
+                steps.append(TCall(stmt.target, callee, stmt.line))
+    return tuple(steps)
+
+
+def compile_block(block: Block, checks: Checks) -> TBlock:
+    """A block's runs, in the order they start, checked for conflicts."""
+    runs: list[Run] = []
+    for line in block.lines:
+        event = checks.event(line)
+        if event is None:
+            continue
+        for mark in line.runs:
+            runs.append(
+                Run(
+                    line.event,
+                    line.line,
+                    mark.start,
+                    mark.exec_end,
+                    mark.hold_end,
+                    event.effectors,
+                    mark.span,
+                )
+            )
+    runs.sort(key=lambda r: (r.start, r.line))
+    conflicts(runs, checks)
+    return TBlock(block.line, block.length, tuple(runs))
+
+
+def conflicts(runs: list[Run], checks: Checks) -> None:
+    """Report runs (sorted by start) that overlap their own event or share an effector."""
+    reported: set[tuple[int, int]] = set()
+    for i, a in enumerate(runs):
+        for b in runs[i + 1 :]:
+            if b.start > a.hold_end:
+                break  # sorted by start: no later run overlaps a
+            first, last = max(a.start, b.start), min(a.hold_end, b.hold_end)
+            key = (a.line, b.line)
+            if first > last or key in reported:
+                continue
+            shared = a.effectors & b.effectors
+            ticks = f"tick {first}" if first == last else f"ticks {first}-{last}"
+            if a.event == b.event and a.line != b.line:
+                reported.add(key)
+                checks.error(
+                    b.span,
+                    f"event '{b.event}' (line {b.line}) overlaps its own run on line "
+                    f"{a.line} in {ticks}",
+                )
+            elif shared:
+                reported.add(key)
+                names = ", ".join(e for e in ("arm", *FINGERS) if e in shared)
+                checks.error(
+                    b.span,
+                    f"effector conflict: '{b.event}' (line {b.line}) and '{a.event}' "
+                    f"(line {a.line}) both command {names} in {ticks}",
+                )
