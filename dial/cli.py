@@ -398,8 +398,9 @@ def build_parser() -> argparse.ArgumentParser:
         help="print the compiled timeline as a chart of absolute ticks",
         description="Print the compiled timeline: one lane per event on absolute ticks "
         "(counted repeats and calls expanded; an until/while loop shown once and marked "
-        "as a loop; both branches of an @if from the same tick), then the sections and "
-        "every run with its executing and held ticks.",
+        "as a loop; both branches of an @if from the same tick; watched spans as '~', and "
+        "each @on reaction laid out after its block), then the sections, every run with its "
+        "executing and held ticks, and the watched spans.",
     )
     p.add_argument("script", metavar="SCRIPT", help="script path or bundled name")
     _scene_argument(p, checking=True)

@@ -70,14 +70,24 @@ class RunMark:
 
 
 @dataclass(frozen=True)
+class WatchMark:
+    """A watched span ``~~~`` on an execution line, in block ticks (1-based, inclusive)."""
+
+    start: int
+    end: int
+    span: Span = field(default=_NOSPAN, compare=False)
+
+
+@dataclass(frozen=True)
 class ExecLine:
-    """An execution line: an event name and its diagram."""
+    """An execution line: an event name and its diagram (runs, or watched spans)."""
 
     event: str
     runs: tuple[RunMark, ...]
-    last_tick: int  # rightmost non-space diagram tick, counting '.'
+    last_tick: int  # rightmost non-space diagram tick, counting '.' and '~'
     line: int = field(default=0, compare=False)
     event_span: Span = field(default=_NOSPAN, compare=False)
+    watches: tuple[WatchMark, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -94,11 +104,17 @@ class Condition:
 
 @dataclass(frozen=True)
 class Block:
-    """Consecutive execution lines sharing one tick axis."""
+    """Consecutive execution lines sharing one tick axis, and the reactions to its monitors."""
 
     lines: tuple[ExecLine, ...]
     length: int
     line: int = field(default=0, compare=False)
+    reactions: tuple[On, ...] = ()
+
+    @property
+    def watched(self) -> tuple[str, ...]:
+        """The events watched in this block, in line order, each once."""
+        return tuple(dict.fromkeys(ln.event for ln in self.lines if ln.watches))
 
 
 @dataclass(frozen=True)
@@ -132,7 +148,40 @@ class Call:
     span: Span = field(default=_NOSPAN, compare=False)
 
 
-Statement = Block | Repeat | If | Call
+@dataclass(frozen=True)
+class On:
+    """``@on COND`` ... ``@end`` after a block: the reaction when a monitor fires."""
+
+    condition: Condition
+    body: tuple[Statement, ...]
+    line: int = field(default=0, compare=False)
+
+
+@dataclass(frozen=True)
+class Resume:
+    """``@resume``: go on after the interrupted block."""
+
+    line: int = field(default=0, compare=False)
+
+
+@dataclass(frozen=True)
+class Retry:
+    """``@retry [max N]``: run the interrupted block again, at most ``max`` times."""
+
+    max: int
+    line: int = field(default=0, compare=False)
+
+
+@dataclass(frozen=True)
+class Abort:
+    """``@abort "MESSAGE"``: end the run with an error naming the monitor."""
+
+    message: str
+    line: int = field(default=0, compare=False)
+
+
+Ending = Resume | Retry | Abort
+Statement = Block | Repeat | If | Call | Resume | Retry | Abort
 
 
 @dataclass(frozen=True)

@@ -16,10 +16,10 @@ from pathlib import Path
 from dial.errors import Diagnostic, ScriptError, Span
 from dial.instructions.catalogue import INSTRUCTIONS, Instruction
 from dial.instructions.scene_names import SceneLoader, SceneNames, SceneNotFoundError
-from dial.instructions.types import Name
+from dial.instructions.types import EFFECTORS, Name
 from dial.parser.ast import Call, Condition, Definition, ExecLine, Program
 from dial.parser.bind import bind
-from dial.parser.compile import compile_body, diagram_events
+from dial.parser.compile import WATCHABLE, compile_body, diagram_events
 from dial.parser.parse import parse_partial
 from dial.parser.script import EventDef, Script
 
@@ -197,6 +197,27 @@ class _Checker:
                 + (f"{hint} (or {define})" if hint else f": {define}"),
             )
         return event
+
+    def watched(self, line: ExecLine) -> bool:
+        event = self.events[line.event]
+        instr = event.instruction
+        if event.effectors or not instr.sensing:
+            what = ", ".join(e for e in EFFECTORS if e in event.effectors) or "an effector"
+            self.error(
+                line.watches[0].span,
+                f"event '{line.event}' cannot be watched: '~' marks a sensing event, and "
+                f"'{line.event}' ({instr.name}) commands {what}",
+            )
+            return False
+        if instr.name not in WATCHABLE:
+            self.error(
+                line.watches[0].span,
+                f"event '{line.event}' ({instr.name}) cannot be watched: only "
+                f"{', '.join(WATCHABLE[:-1])} and {WATCHABLE[-1]} can, because only a contact "
+                "condition holds or not at each moment",
+            )
+            return False
+        return True
 
     def condition(self, cond: Condition | None) -> None:
         if cond is None or cond.event in self.broken:

@@ -11,8 +11,37 @@ from typing import Protocol
 
 from dial.errors import Span
 from dial.instructions.types import FINGERS
-from dial.parser.ast import Block, Call, Condition, ExecLine, If, Repeat, Statement
-from dial.parser.script import EventDef, Run, Script, Step, TBlock, TCall, TIf, TRepeat
+from dial.parser.ast import (
+    Abort,
+    Block,
+    Call,
+    Condition,
+    ExecLine,
+    If,
+    Repeat,
+    Resume,
+    Retry,
+    Statement,
+)
+from dial.parser.script import (
+    EventDef,
+    Run,
+    Script,
+    Step,
+    TAbort,
+    TBlock,
+    TCall,
+    TIf,
+    TOn,
+    TRepeat,
+    TResume,
+    TRetry,
+    Watch,
+)
+
+# The instructions whose condition holds or not at each moment, so that a monitor can
+# sense it every control period: the contact conditions.
+WATCHABLE = ("position_contact", "force_contact", "tactile_contact")
 
 
 class Checks(Protocol):
@@ -23,6 +52,9 @@ class Checks(Protocol):
 
     def event(self, line: ExecLine) -> EventDef | None:
         """The bound event of an execution line, or None (its problem is reported)."""
+
+    def watched(self, line: ExecLine) -> bool:
+        """Whether the watched line's event may be watched (if not, it is reported)."""
 
     def condition(self, cond: Condition | None) -> None:
         """Check a condition of ``@if`` or ``@repeat``."""
@@ -37,6 +69,8 @@ def diagram_events(body: tuple[Statement, ...]) -> set[str]:
     for stmt in body:
         if isinstance(stmt, Block):
             names.update(line.event for line in stmt.lines)
+            for r in stmt.reactions:
+                names |= diagram_events(r.body)
         elif isinstance(stmt, Repeat):
             names |= diagram_events(stmt.body)
         elif isinstance(stmt, If):
@@ -58,20 +92,29 @@ def compile_body(body: tuple[Statement, ...], checks: Checks) -> tuple[Step, ...
             checks.condition(stmt.condition)
             then, orelse = compile_body(stmt.then, checks), compile_body(stmt.orelse, checks)
             steps.append(TIf(stmt.condition, then, orelse, stmt.line))
-        else:
+        elif isinstance(stmt, Call):
             callee = checks.call(stmt)
             if callee is not None:
                 steps.append(TCall(stmt.target, callee, stmt.line))
+        elif isinstance(stmt, Resume):
+            steps.append(TResume(stmt.line))
+        elif isinstance(stmt, Retry):
+            steps.append(TRetry(stmt.max, stmt.line))
+        elif isinstance(stmt, Abort):
+            steps.append(TAbort(stmt.message, stmt.line))
     return tuple(steps)
 
 
 def compile_block(block: Block, checks: Checks) -> TBlock:
-    """A block's runs, in the order they start, checked for conflicts."""
+    """A block: its runs in the order they start (checked for conflicts), watches, reactions."""
     runs: list[Run] = []
+    watches: list[Watch] = []
     for line in block.lines:
         event = checks.event(line)
         if event is None:
             continue
+        if line.watches and checks.watched(line):
+            watches += (Watch(line.event, line.line, w.start, w.end, w.span) for w in line.watches)
         for mark in line.runs:
             runs.append(
                 Run(
@@ -86,7 +129,12 @@ def compile_block(block: Block, checks: Checks) -> TBlock:
             )
     runs.sort(key=lambda r: (r.start, r.line))
     conflicts(runs, checks)
-    return TBlock(block.line, block.length, tuple(runs))
+    watches.sort(key=lambda w: (w.start, w.line))
+    overlapping_watches(watches, checks)
+    reactions = tuple(
+        TOn(r.condition, compile_body(r.body, checks), r.line) for r in block.reactions
+    )
+    return TBlock(block.line, block.length, tuple(runs), tuple(watches), reactions)
 
 
 def conflicts(runs: list[Run], checks: Checks) -> None:
@@ -117,3 +165,19 @@ def conflicts(runs: list[Run], checks: Checks) -> None:
                     f"effector conflict: '{b.event}' (line {b.line}) and '{a.event}' "
                     f"(line {a.line}) both command {names} in {ticks}",
                 )
+
+
+def overlapping_watches(watches: list[Watch], checks: Checks) -> None:
+    """Report a watched span (sorted by start) that overlaps another of its event."""
+    last: dict[str, Watch] = {}  # per event, the watch that reaches furthest so far
+    for w in watches:
+        prev = last.get(w.event)
+        if prev is not None and w.start <= prev.end:
+            end = min(w.end, prev.end)
+            ticks = f"tick {w.start}" if w.start == end else f"ticks {w.start}-{end}"
+            checks.error(
+                w.span,
+                f"event '{w.event}' is watched twice in {ticks} (lines {prev.line} and {w.line})",
+            )
+        if prev is None or w.end > prev.end:
+            last[w.event] = w

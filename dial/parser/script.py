@@ -54,10 +54,50 @@ class Run:
 
 
 @dataclass(frozen=True)
+class Watch:
+    """A watched span: sensing event ``event`` sensed every control period of block ticks
+    start..end."""
+
+    event: str
+    line: int
+    start: int
+    end: int
+    span: Span = field(default=Span(0, 0, 0), compare=False)
+
+
+@dataclass(frozen=True)
+class TOn:
+    """``@on COND`` ... ``@end``: the reaction to a monitor of the block it follows."""
+
+    condition: Condition
+    body: tuple[Step, ...]
+    line: int
+
+
+@dataclass(frozen=True)
+class TResume:
+    line: int
+
+
+@dataclass(frozen=True)
+class TRetry:
+    max: int
+    line: int
+
+
+@dataclass(frozen=True)
+class TAbort:
+    message: str
+    line: int
+
+
+@dataclass(frozen=True)
 class TBlock:
     line: int
-    length: int
+    length: int  # ticks, counting watched ones
     runs: tuple[Run, ...]  # ordered by start tick, then line: the order runs start in
+    watches: tuple[Watch, ...] = ()  # in (start, line) order
+    reactions: tuple[TOn, ...] = ()  # in file order: the first that fires in a period wins
 
 
 @dataclass(frozen=True)
@@ -84,7 +124,7 @@ class TCall:
     line: int
 
 
-Step = TBlock | TRepeat | TIf | TCall
+Step = TBlock | TRepeat | TIf | TCall | TResume | TRetry | TAbort
 
 
 @dataclass(frozen=True)
