@@ -8,7 +8,9 @@ world file (unknown pose, location or program) go through a
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+import gc
+from collections.abc import Iterator, Mapping
+from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
 from difflib import get_close_matches
 from pathlib import Path
@@ -51,6 +53,12 @@ class _Context:
     stack: tuple[str, ...] = ()  # resolved paths of the calling scripts, for call cycles
     # The scene of the calling script: a called script runs in its caller's scene.
     caller_scene: _CallerScene = None
+    depth: int = 0  # the nesting level of the '@call' that runs this script
+    # Checked callees by (path, id of the scene they run in, level): the script (None if it
+    # has problems), and the scene, kept alive so that its id stays its own.
+    callees: dict[tuple[str, int, int], tuple[Script | None, _CallerScene]] = field(
+        default_factory=dict
+    )
 
     def entering(self, origin: Path) -> _Context:
         """The context inside the script at ``origin``."""
@@ -114,6 +122,9 @@ class _Checker:
         except ValueError as e:
             self.scene_failed = True
             self.error(span, f"scene '{text}' has a bad world file: {e}")
+        except OSError as e:  # a name the file system refuses
+            self.scene_failed = True
+            self.error(span, f"cannot read scene '{text}': {_reason(e)}")
 
     def define(self, d: Definition) -> None:
         if d.broken:  # its syntax error is reported already
@@ -238,8 +249,13 @@ class _Checker:
             )
 
     def call(self, stmt: Call) -> Script | None:
-        target = (self.origin.parent / stmt.target).resolve()
-        if not target.is_file():
+        try:
+            target = (self.origin.parent / stmt.target).resolve()
+            found = target.is_file()
+        except (OSError, ValueError) as e:  # a name the file system refuses
+            self.error(stmt.span, f"cannot read called script '{stmt.target}': {_reason(e)}")
+            return None
+        if not found:
             here = Path(self.program.path).parent
             self.error(stmt.span, f"cannot find called script '{stmt.target}' (looked in {here})")
             return None
@@ -248,11 +264,28 @@ class _Checker:
             chain = " -> ".join(Path(p).name for p in (*self.ctx.stack, key))
             self.error(stmt.span, f"call cycle: {chain}")
             return None
-        before = len(self.ctx.diags)
-        display = str(Path(self.program.path).parent / stmt.target)
         inherited: _CallerScene = _SCENE_FAILED if self.scene_failed else self.scene
-        callee = _check_file(target, display, replace(self.ctx, caller_scene=inherited))
-        return None if len(self.ctx.diags) > before else callee
+        # A script called many times (or from many callers) is checked once per scene and
+        # level: a chain of scripts that each call the next twice stays linear.
+        memo = (key, id(inherited), stmt.depth)
+        if memo not in self.ctx.callees:
+            before = len(self.ctx.diags)
+            display = str(Path(self.program.path).parent / stmt.target)
+            ctx = replace(self.ctx, caller_scene=inherited, depth=stmt.depth)
+            callee: Script | None = None
+            try:
+                callee = _check_file(target, display, ctx)
+            except OSError as e:
+                self.error(stmt.span, f"cannot read called script '{stmt.target}': {_reason(e)}")
+            ok = callee is not None and len(self.ctx.diags) == before
+            self.ctx.callees[memo] = (callee, inherited) if ok else (None, inherited)
+        return self.ctx.callees[memo][0]
+
+
+def _reason(e: OSError | ValueError) -> str:
+    if isinstance(e, OSError) and e.strerror:
+        return e.strerror
+    return str(e)
 
 
 def _check(text: str, path: str, origin: Path, ctx: _Context) -> Script:
@@ -261,7 +294,7 @@ def _check(text: str, path: str, origin: Path, ctx: _Context) -> Script:
     ``path`` is how messages name the file; ``origin`` is the real file that ``@call``
     and ``@scene`` paths are relative to.
     """
-    program, syntax = parse_partial(text, path)
+    program, syntax = parse_partial(text, path, depth=ctx.depth)
     ctx.diags.extend(syntax)
     return _Checker(program, text, origin, ctx.entering(origin)).run()
 
@@ -269,6 +302,19 @@ def _check(text: str, path: str, origin: Path, ctx: _Context) -> Script:
 def _check_file(path: Path, display: str, ctx: _Context) -> Script:
     text = path.read_text(encoding="utf-8", errors="replace")
     return _check(text, display, path, ctx)
+
+
+@contextmanager
+def _no_gc() -> Iterator[None]:
+    """Pause the cyclic garbage collector: a script's tree holds no cycles, and on a large
+    script its full collections would make the check's cost grow faster than its size."""
+    enabled = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if enabled:
+            gc.enable()
 
 
 def _finish(script: Script, ctx: _Context) -> Script:
@@ -288,7 +334,8 @@ def check_text(
     of every script it calls.
     """
     ctx = _Context(loader, scene)
-    return _finish(_check(text, path, Path(path), ctx), ctx)
+    with _no_gc():
+        return _finish(_check(text, path, Path(path), ctx), ctx)
 
 
 def load(
@@ -304,4 +351,5 @@ def load(
     ``loader`` are as for :func:`check_text`.
     """
     ctx = _Context(loader, scene)
-    return _finish(_check_file(Path(path), display or str(path), ctx), ctx)
+    with _no_gc():
+        return _finish(_check_file(Path(path), display or str(path), ctx), ctx)

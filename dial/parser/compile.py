@@ -7,6 +7,7 @@ asks the checker through :class:`Checks`, which also collects the problems.
 
 from __future__ import annotations
 
+from operator import attrgetter
 from typing import Protocol
 
 from dial.errors import Span
@@ -42,6 +43,7 @@ from dial.parser.script import (
 # The instructions whose condition holds or not at each moment, so that a monitor can
 # sense it every control period: the contact conditions.
 WATCHABLE = ("position_contact", "force_contact", "tactile_contact")
+_START_LINE = attrgetter("start", "line")
 
 
 class Checks(Protocol):
@@ -115,21 +117,13 @@ def compile_block(block: Block, checks: Checks) -> TBlock:
             continue
         if line.watches and checks.watched(line):
             watches += (Watch(line.event, line.line, w.start, w.end, w.span) for w in line.watches)
-        for mark in line.runs:
-            runs.append(
-                Run(
-                    line.event,
-                    line.line,
-                    mark.start,
-                    mark.exec_end,
-                    mark.hold_end,
-                    event.effectors,
-                    mark.span,
-                )
-            )
-    runs.sort(key=lambda r: (r.start, r.line))
+        name, number, effectors = line.event, line.line, event.effectors
+        runs += [
+            Run(name, number, m.start, m.exec_end, m.hold_end, effectors, m.span) for m in line.runs
+        ]
+    runs.sort(key=_START_LINE)
     conflicts(runs, checks)
-    watches.sort(key=lambda w: (w.start, w.line))
+    watches.sort(key=_START_LINE)
     overlapping_watches(watches, checks)
     reactions = tuple(
         TOn(r.condition, compile_body(r.body, checks), r.line) for r in block.reactions
@@ -138,33 +132,49 @@ def compile_block(block: Block, checks: Checks) -> TBlock:
 
 
 def conflicts(runs: list[Run], checks: Checks) -> None:
-    """Report runs (sorted by start) that overlap their own event or share an effector."""
+    """Report runs (sorted by start) that overlap their own event or share an effector.
+
+    One sweep per effector and per event: a run conflicts when it starts before the run
+    that reaches furthest so far on the same effector (or of the same event) ends, so the
+    cost is linear in the number of runs.
+    """
     reported: set[tuple[int, int]] = set()
-    for i, a in enumerate(runs):
-        for b in runs[i + 1 :]:
-            if b.start > a.hold_end:
-                break  # sorted by start: no later run overlaps a
-            first, last = max(a.start, b.start), min(a.hold_end, b.hold_end)
-            key = (a.line, b.line)
-            if first > last or key in reported:
-                continue
-            shared = a.effectors & b.effectors
-            ticks = f"tick {first}" if first == last else f"ticks {first}-{last}"
-            if a.event == b.event and a.line != b.line:
-                reported.add(key)
-                checks.error(
-                    b.span,
-                    f"event '{b.event}' (line {b.line}) overlaps its own run on line "
-                    f"{a.line} in {ticks}",
-                )
-            elif shared:
-                reported.add(key)
-                names = ", ".join(e for e in ("arm", *FINGERS) if e in shared)
-                checks.error(
-                    b.span,
-                    f"effector conflict: '{b.event}' (line {b.line}) and '{a.event}' "
-                    f"(line {a.line}) both command {names} in {ticks}",
-                )
+    furthest: dict[str, Run] = {}  # per effector
+    own: dict[str, Run] = {}  # per event
+    for b in runs:
+        a = own.get(b.event)
+        if a is None or b.hold_end > a.hold_end:
+            own[b.event] = b
+        if a is not None and b.start <= a.hold_end and a.line != b.line:
+            _conflict(a, b, reported, checks)
+        for effector in b.effectors:
+            a = furthest.get(effector)
+            if a is None or b.hold_end > a.hold_end:
+                furthest[effector] = b
+            if a is not None and b.start <= a.hold_end:
+                _conflict(a, b, reported, checks)
+
+
+def _conflict(a: Run, b: Run, reported: set[tuple[int, int]], checks: Checks) -> None:
+    """Report that ``b`` overlaps ``a`` (which starts no later), once per pair of lines."""
+    if (a.line, b.line) in reported:
+        return
+    reported.add((a.line, b.line))
+    ticks = _ticks(b.start, min(a.hold_end, b.hold_end))
+    if a.event == b.event:
+        message = f"event '{b.event}' (line {b.line}) overlaps its own run on line {a.line}"
+    else:
+        shared = a.effectors & b.effectors
+        names = ", ".join(e for e in ("arm", *FINGERS) if e in shared)
+        message = (
+            f"effector conflict: '{b.event}' (line {b.line}) and '{a.event}' "
+            f"(line {a.line}) both command {names}"
+        )
+    checks.error(b.span, f"{message} in {ticks}")
+
+
+def _ticks(first: int, last: int) -> str:
+    return f"tick {first}" if first == last else f"ticks {first}-{last}"
 
 
 def overlapping_watches(watches: list[Watch], checks: Checks) -> None:
@@ -173,8 +183,7 @@ def overlapping_watches(watches: list[Watch], checks: Checks) -> None:
     for w in watches:
         prev = last.get(w.event)
         if prev is not None and w.start <= prev.end:
-            end = min(w.end, prev.end)
-            ticks = f"tick {w.start}" if w.start == end else f"ticks {w.start}-{end}"
+            ticks = _ticks(w.start, min(w.end, prev.end))
             checks.error(
                 w.span,
                 f"event '{w.event}' is watched twice in {ticks} (lines {prev.line} and {w.line})",

@@ -10,7 +10,7 @@ import re
 from collections.abc import Callable
 from typing import Literal
 
-from dial.errors import Span
+from dial.errors import Span, shorten
 from dial.parser.ast import Condition, Param, Word
 
 _COND = re.compile(r"(!?)([A-Za-z_][A-Za-z0-9_]*)$")
@@ -48,7 +48,7 @@ def count(error: Report, word: Word, what: str, hi: int) -> int | None:
         or len(text) > len(str(hi))
         or not 1 <= int(text) <= hi
     ):
-        error(word.span, f"expected {what}, got '{text}'")
+        error(word.span, f"expected {what}, got '{shorten(text)}'")
         return None
     return int(text)
 
@@ -106,3 +106,33 @@ def abort_message(error: Report, span: Span, params: list[Param]) -> str | None:
         error(where, "'@abort' takes one quoted message: @abort \"MESSAGE\"")
         return None
     return " ".join(w.text for w in params[0].words)
+
+
+MAX_NAME_BYTES = 255  # one file or directory name, as file systems allow
+MAX_PATH_CHARS = 1024
+
+
+def file_path(error: Report, word: Word, what: str) -> bool:
+    """Whether ``word`` can name a file (if not, reported): no control character, and
+    within the length that file systems allow."""
+    text = word.text
+    bad = next((i for i, ch in enumerate(text) if ord(ch) < 32 or ord(ch) == 127), None)
+    if bad is not None:
+        code = f"U+{ord(text[bad]):04X}" + (" (NUL)" if text[bad] == "\0" else "")
+        error(
+            Span.at(word.span.line, word.span.col + bad),
+            f"{what} holds the control character {code}",
+        )
+        return False
+    if len(text) > MAX_PATH_CHARS:
+        error(word.span, f"{what} is {len(text)} characters long; at most {MAX_PATH_CHARS}")
+        return False
+    long = next((p for p in text.split("/") if len(p.encode()) > MAX_NAME_BYTES), None)
+    if long is not None:
+        error(
+            word.span,
+            f"{what} has a name of {len(long.encode())} bytes ('{long[:20]}...'); file names "
+            f"are at most {MAX_NAME_BYTES}",
+        )
+        return False
+    return True

@@ -6,8 +6,9 @@ The parser recovers line by line, so one pass reports every syntax problem.
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
 from difflib import get_close_matches
+from functools import lru_cache
+from typing import NamedTuple
 
 from dial.errors import Diagnostic, ScriptError, Span
 from dial.parser import directives as args
@@ -30,6 +31,7 @@ from dial.parser.words import WordError, tokenize
 from dial.units import UnitError, parse_quantity
 
 NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+_GAP = re.compile(r"[^\S\t]*")  # whitespace up to the diagram; a tab there is an error
 DIRECTIVES = (
     *("scene", "tick", "repeat", "if", "else", "end", "call"),
     *("on", "resume", "retry", "abort"),
@@ -37,25 +39,62 @@ DIRECTIVES = (
 MAX_TICK_S = 60.0
 
 
-@dataclass
-class _PendingLine:
-    line: Line
+class _PendingLine(NamedTuple):
+    number: int
     event: str
-    event_span: Span
     first_col: int  # 0-based column of the first diagram character
     last_col: int
     marks: Diagram  # 0-based columns
 
 
+class _Problem(NamedTuple):
+    col: int  # 1-based, on the line being read
+    end_col: int
+    message: str
+
+
+@lru_cache(maxsize=4096)
+def _read_execution(code: str) -> tuple[str, int, int, Diagram] | _Problem:
+    """An execution line (comments blanked, right-stripped): its event, the first and last
+    diagram columns and the marks; or its first problem.
+
+    A pure function of the text, cached: long scripts repeat their lines.
+    """
+    m = NAME.match(code)
+    assert m is not None  # the scanner classified the line by its first character
+    event = m.group()
+    j = m.end()
+    if j >= len(code):
+        return _Problem(
+            1, j + 1, f"execution line for '{event}' has no diagram: add ticks after it"
+        )
+    if not code[j].isspace():
+        return _Problem(
+            j + 1,
+            j + 2,
+            f"unexpected '{code[j]}' after event name '{event}': names match "
+            "[A-Za-z_][A-Za-z0-9_]* and are followed by spaces and the diagram",
+        )
+    first = _GAP.match(code, j).end()  # type: ignore[union-attr]  # matches empty too
+    if code[first] == "\t":
+        return _Problem(
+            first + 1, first + 2, "tab before the diagram: its column is ambiguous; use spaces"
+        )
+    marks = read_diagram(code, first, event)
+    if not isinstance(marks, Diagram):
+        return _Problem(marks[0] + 1, marks[0] + 2, marks[1])
+    return event, first, len(code) - 1, marks
+
+
 class _Parser:
-    def __init__(self, text: str, path: str) -> None:
+    def __init__(self, text: str, path: str, depth: int = 0) -> None:
         self.path = path
         self.lines, problems = scan(text)
         self.by_number = {ln.number: ln for ln in self.lines}
         self.diags: list[Diagnostic] = []
         for span, message in problems:
             self.error(span, message)
-        self.structure = Structure(self.error)
+        self.structure = Structure(self.error, depth)
         self.block: list[_PendingLine] = []
         self.block_ok = True
         self.definitions: dict[str, Definition] = {}
@@ -69,18 +108,21 @@ class _Parser:
 
     # -- driver ---------------------------------------------------------------------------
     def run(self) -> Program:
+        execution, comment = Kind.EXECUTION, Kind.COMMENT
         for ln in self.lines:
-            if ln.kind is Kind.COMMENT:
-                continue
-            if ln.kind is not Kind.EXECUTION:
-                self.flush()
-            if ln.kind is Kind.EXECUTION:
+            kind = ln.kind
+            if kind is execution:
                 self.execution(ln)
-            elif ln.kind is Kind.DEFINITION:
+                continue
+            if kind is comment:
+                continue
+            if self.block:
+                self.flush()
+            if kind is Kind.DEFINITION:
                 self.definition(ln)
-            elif ln.kind is Kind.DIRECTIVE:
+            elif kind is Kind.DIRECTIVE:
                 self.directive(ln)
-            elif ln.kind is Kind.OTHER:
+            elif kind is Kind.OTHER:
                 self.other(ln)
         self.flush()
         body = self.structure.finish()
@@ -164,34 +206,14 @@ class _Parser:
 
     # -- execution lines and blocks --------------------------------------------------------
     def execution(self, ln: Line) -> None:
-        code = ln.code.rstrip()
-        m = NAME.match(code)
-        assert m is not None  # the scanner classified the line by its first character
-        event, span = m.group(), Span(ln.number, 1, m.end() + 1)
-        j = m.end()
-        problem: tuple[Span, str] | None = None
-        if j >= len(code):
-            problem = span, f"execution line for '{event}' has no diagram: add ticks after it"
-        elif not code[j].isspace():
-            problem = (
-                Span.at(ln.number, j + 1),
-                f"unexpected '{code[j]}' after event name '{event}': names match "
-                "[A-Za-z_][A-Za-z0-9_]* and are followed by spaces and the diagram",
-            )
-        else:
-            while code[j].isspace() and code[j] != "\t":
-                j += 1
-            if code[j] == "\t":
-                problem = (
-                    Span.at(ln.number, j + 1),
-                    "tab before the diagram: its column is ambiguous; use spaces",
-                )
-        marks = read_diagram(ln.number, code, j, event) if problem is None else problem
-        if isinstance(marks, tuple):
+        read = _read_execution(ln.code.rstrip())
+        number = ln.number
+        if isinstance(read, _Problem):
             self.block_ok = False
-            self.error(*marks)
+            self.error(Span(number, read.col, read.end_col), read.message)
             return
-        self.block.append(_PendingLine(ln, event, span, j, len(code) - 1, marks))
+        event, first, last, marks = read
+        self.block.append(_PendingLine(number, event, first, last, marks))
 
     def flush(self) -> None:
         pending, ok = self.block, self.block_ok
@@ -201,23 +223,28 @@ class _Parser:
         if not ok:
             self.structure.drop_block()
             return
-        base = min(p.first_col for p in pending)
-        lines = tuple(self.exec_line(p, base) for p in pending)
+        base = min([p.first_col for p in pending])
+        lines = tuple([self.exec_line(p, base) for p in pending])
         length = max(x.last_tick for x in lines)
-        self.structure.add(Block(lines, length, pending[0].line.number), pending[0].event_span)
+        self.structure.add(Block(lines, length, pending[0].number), lines[0].event_span)
 
     @staticmethod
     def exec_line(p: _PendingLine, base: int) -> ExecLine:
-        number = p.line.number
+        number = p.number
+        shift = 1 - base
         runs = tuple(
-            RunMark(s - base + 1, e - base + 1, h - base + 1, Span(number, s + 1, h + 2))
-            for s, e, h in p.marks.runs
+            [
+                RunMark(s + shift, e + shift, h + shift, Span(number, s + 1, h + 2))
+                for s, e, h in p.marks.runs
+            ]
         )
         watches = tuple(
-            WatchMark(s - base + 1, e - base + 1, Span(number, s + 1, e + 2))
-            for s, e in p.marks.watches
+            [
+                WatchMark(s + shift, e + shift, Span(number, s + 1, e + 2))
+                for s, e in p.marks.watches
+            ]
         )
-        return ExecLine(p.event, runs, p.last_col - base + 1, number, p.event_span, watches)
+        return ExecLine(p.event, runs, p.last_col - base + 1, number, watches)
 
     # -- directives -----------------------------------------------------------------------
     def directive(self, ln: Line) -> None:
@@ -267,8 +294,13 @@ class _Parser:
             self.d_tick(ln, span, words)
         elif name == "call":
             form = "one path: @call FILE.dial"
-            if args.arity(self.error, span, "call", words, 1, form):
-                self.structure.add(Call(words[0].text, ln.number, words[0].span), span)
+            if (
+                args.arity(self.error, span, "call", words, 1, form)
+                and args.file_path(self.error, words[0], "the called script's path")
+                and self.structure.within_limit("call", span)
+            ):
+                level = self.structure.level
+                self.structure.add(Call(words[0].text, ln.number, words[0].span, level), span)
         elif name in ("resume", "retry", "abort"):
             self.structure.ending(name, span, params, ln.number)
 
@@ -285,6 +317,8 @@ class _Parser:
         if not args.arity(self.error, span, "scene", words, 1, form):
             return
         if not self._top_level(span, "scene"):
+            return
+        if not args.file_path(self.error, words[0], "the scene name or path"):
             return
         if self.scene is not None:
             self.error(span, f"'@scene' is already set on line {self.scene.line}")
@@ -314,9 +348,15 @@ class _Parser:
         self.tick, self.tick_value = Setting(w.text, ln.number, w.span), value
 
 
-def parse_partial(text: str, path: str = "<script>") -> tuple[Program, list[Diagnostic]]:
-    """Parse what can be parsed; return the program and every syntax problem."""
-    parser = _Parser(text, path)
+def parse_partial(
+    text: str, path: str = "<script>", *, depth: int = 0
+) -> tuple[Program, list[Diagnostic]]:
+    """Parse what can be parsed; return the program and every syntax problem.
+
+    ``depth`` is the nesting level of the ``@call`` that runs this script, if any: it counts
+    towards :data:`~dial.parser.structure.MAX_NESTING`.
+    """
+    parser = _Parser(text, path, depth)
     program = parser.run()
     return program, parser.diags
 

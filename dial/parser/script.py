@@ -28,7 +28,7 @@ class EventDef:
     definition: Definition
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class Run:
     """One run of an event inside a block.
 
@@ -91,7 +91,7 @@ class TAbort:
     line: int
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class TBlock:
     line: int
     length: int  # ticks, counting watched ones

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from dial.instructions.types import EFFECTORS
 from dial.parser.script import Script
-from dial.parser.timeline import Layout, Placed, PlacedWatch, Section, expand
+from dial.parser.timeline import MAX_ITEMS, MAX_TICKS, Layout, Placed, PlacedWatch, Section, expand
 
 
 def _ranges(ticks: range) -> str:
@@ -42,6 +42,18 @@ def _where(s: Section) -> str:
     return f"{s.first}-{s.last}" if s.first <= s.last else f"after {s.last}"
 
 
+def _compact_note(layout: Layout) -> str:
+    """What a compact layout leaves out."""
+    note = (
+        f"(shown compactly: expanded, the timeline exceeds {MAX_TICKS} ticks or "
+        f"{MAX_ITEMS} runs and sections, so each counted @repeat is drawn once and the ticks "
+        "below are not absolute"
+    )
+    if layout.cut:
+        note += f"; the chart stops after tick {layout.length}"
+    return note + ")"
+
+
 def render(script: Script, layout: Layout | None = None) -> str:
     """The chart (one lane per event), the sections, and every run with its ticks."""
     layout = layout or expand(script)
@@ -50,12 +62,18 @@ def render(script: Script, layout: Layout | None = None) -> str:
     tick = f"tick {script.tick:g} s" if script.tick is not None else "default tick"
     own = script.program.scene.text if script.program.scene else None
     scene = script.scene_override or own or "none"
-    out = [f"{script.path}: scene {scene}, {tick}, {layout.length} ticks", ""]
-    out.append("tick".ljust(width) + _ruler(layout.length))
+    out = [f"{script.path}: scene {scene}, {tick}, {layout.expanded or layout.length} ticks"]
+    if layout.compact:
+        out.append(_compact_note(layout))
+    out += ["", "tick".ljust(width) + _ruler(layout.length)]
+    runs: dict[str, list[Placed]] = {name: [] for name in names}
+    watched: dict[str, list[PlacedWatch]] = {name: [] for name in names}
+    for p in layout.runs:
+        runs[p.run.event].append(p)
+    for w in layout.watches:
+        watched[w.watch.event].append(w)
     for name in names:
-        runs = [p for p in layout.runs if p.run.event == name]
-        watched = [w for w in layout.watches if w.watch.event == name]
-        out.append(name.ljust(width) + _lane(runs, watched, layout.length))
+        out.append(name.ljust(width) + _lane(runs[name], watched[name], layout.length))
     out += ["", "sections:"]
     span_w = max([len(_where(s)) for s in layout.sections] + [5])
     for s in layout.sections:

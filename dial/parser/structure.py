@@ -28,6 +28,10 @@ from dial.parser.ast import (
 )
 
 ENDINGS = {Resume: "resume", Retry: "retry", Abort: "abort"}
+# Levels of '@repeat', '@if', '@on' and '@call' (through every called script): the checker,
+# the display and the runner recurse once per level, so a limit keeps them off Python's
+# recursion limit, with room to spare.
+MAX_NESTING = 100
 FrameKind = Literal["top", "repeat", "if", "on"]
 
 
@@ -41,13 +45,16 @@ class _Frame:
     repeat: args.RepeatSpec | None = None
     condition: Condition | None = None  # of '@if'; of '@on' only when it attaches to a block
     line: int = 0
+    too_deep: bool = False  # beyond MAX_NESTING: reported, and dropped with what it holds
+    lost: bool = False  # a nested directive of it was dropped (its problem is reported)
 
 
 class Structure:
     """The open directives, innermost last, and the statements each has collected."""
 
-    def __init__(self, error: args.Report) -> None:
+    def __init__(self, error: args.Report, depth: int = 0) -> None:
         self.error = error
+        self.base = depth  # the nesting level of the '@call' that runs this script
         self.stack: list[_Frame] = [_Frame("top", Span(1, 1, 2))]
         # The statement list a broken block was dropped from, and its length then: an '@on'
         # right after it is not also reported as following no block.
@@ -120,24 +127,45 @@ class Structure:
         """``@repeat``, ``@if`` or ``@on``: push a frame that ``@end`` closes."""
         self.reachable(span)
         report = self.error
+        deep = self.stack[-1].too_deep or not self.within_limit(name, span)
         if name == "repeat":
             spec = args.repeat_spec(report, span, line_span, words) if words is not None else None
-            self.stack.append(_Frame("repeat", span, repeat=spec, line=number))
+            frame = _Frame("repeat", span, repeat=spec, line=number)
         elif name == "if":
             cond = args.one_condition(report, span, "if", words) if words is not None else None
-            self.stack.append(_Frame("if", span, condition=cond, line=number))
+            frame = _Frame("if", span, condition=cond, line=number)
         else:
             cond = args.one_condition(report, span, "on", words) if words is not None else None
-            cond = self.watched_block(span, cond)
-            self.stack.append(_Frame("on", span, condition=cond, line=number))
+            cond = self.watched_block(span, None if deep else cond)
+            frame = _Frame("on", span, condition=cond, line=number)
+        frame.too_deep = deep
+        self.stack.append(frame)
+
+    @property
+    def level(self) -> int:
+        """The nesting level of a directive opened now, counting the calls that lead here."""
+        return self.base + len(self.stack)
+
+    def within_limit(self, name: str, span: Span) -> bool:
+        """Whether ``@name`` opened now stays within :data:`MAX_NESTING` (if not, reported)."""
+        if self.level <= MAX_NESTING:
+            return True
+        if not self.stack[-1].too_deep:  # only the first directive beyond the limit
+            calls = f" (the calls that lead to this script take {self.base})" if self.base else ""
+            self.error(
+                span,
+                f"'@{name}' is nested {self.level} levels deep: at most {MAX_NESTING} levels of "
+                f"'@repeat', '@if', '@on' and '@call' are allowed{calls}",
+            )
+        return False
 
     def watched_block(self, span: Span, cond: Condition | None) -> Condition | None:
         """``cond`` if the ``@on`` directly follows a block that watches its event."""
         stmts = self.statements()
         block = stmts[-1] if stmts and isinstance(stmts[-1], Block) else None
         if block is None:
-            after_dropped = self.dropped is not None and self.dropped[0] is stmts
-            if not after_dropped or self.dropped is None or self.dropped[1] != len(stmts):
+            dropped = self.dropped
+            if dropped is None or dropped[0] is not stmts or dropped[1] != len(stmts):
                 self.error(span, "'@on' must come directly after the block it watches")
             return None
         if cond is not None and cond.event not in block.watched:
@@ -193,7 +221,9 @@ class Structure:
             self.error(span, "'@end' without a matching '@repeat', '@if' or '@on'")
             return
         frame = self.stack.pop()
-        stmt: Statement
+        if frame.too_deep or (frame.lost and not frame.statements and not frame.then):
+            self.stack[-1].lost = True
+            return
         if frame.kind == "on":
             if frame.condition is not None:  # else its header was reported as an error
                 stmts = self.statements()
@@ -202,17 +232,22 @@ class Structure:
                 on = On(frame.condition, tuple(frame.statements), frame.line)
                 stmts[-1] = replace(block, reactions=(*block.reactions, on))
             return
-        if frame.kind == "repeat":
-            if not frame.statements and frame.repeat is not None:
-                self.error(frame.span, "'@repeat' encloses no execution lines")
-                return
-            if frame.repeat is None:
-                return  # its header was reported as an error
-            kind, count, cond = frame.repeat
-            body = tuple(frame.statements)
-            stmt = Repeat(kind, count, cond, body, frame.line, frame.span)
+        stmt = self.closed(frame)
+        if stmt is None:
+            self.stack[-1].lost = True
         else:
-            if frame.condition is None:
-                return
-            stmt = If(frame.condition, tuple(frame.then), tuple(frame.statements), frame.line)
-        self.statements().append(stmt)
+            self.statements().append(stmt)
+
+    def closed(self, frame: _Frame) -> Repeat | If | None:
+        """The statement an ``@end`` closes, or None if it has a problem (reported)."""
+        if frame.kind == "repeat":
+            if frame.repeat is None:
+                return None  # its header was reported as an error
+            if not frame.statements:
+                self.error(frame.span, "'@repeat' encloses no execution lines")
+                return None
+            kind, count, cond = frame.repeat
+            return Repeat(kind, count, cond, tuple(frame.statements), frame.line, frame.span)
+        if frame.condition is None:
+            return None
+        return If(frame.condition, tuple(frame.then), tuple(frame.statements), frame.line)

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 from dataclasses import dataclass
+from typing import NamedTuple
 
 from dial.parser.script import (
     Run,
@@ -76,9 +77,15 @@ class PlacedWatch:
 class Layout:
     runs: tuple[Placed, ...]
     sections: tuple[Section, ...]
-    length: int
+    length: int  # ticks laid out
     watches: tuple[PlacedWatch, ...] = ()
     lanes: tuple[str, ...] = ()  # every event with a run or a watch, in the order met
+    # Laid out compactly (too large to expand): each counted repeat drawn once, so ticks after
+    # one are not absolute; ``cut`` if the layout also stops early. ``expanded`` is the
+    # length of the whole expanded timeline, which :func:`length` gives without laying out.
+    compact: bool = False
+    cut: bool = False
+    expanded: int = 0
 
 
 def ending_text(step: TResume | TRetry | TAbort) -> str:
@@ -90,23 +97,94 @@ def ending_text(step: TResume | TRetry | TAbort) -> str:
     return f'@abort "{step.message}"'
 
 
+# A timeline that expands to more ticks or items (runs, watches, sections) than this is laid
+# out compactly, and a compact layout stops once it reaches them: what a chart can show.
+MAX_TICKS = 5_000
+MAX_ITEMS = 20_000
+
+
+class Size(NamedTuple):
+    """What an expanded timeline holds: its ticks, and its runs, watches and sections."""
+
+    ticks: int
+    items: int
+
+
+class _Measure:
+    """The size of the expanded timeline, by arithmetic: nothing is unrolled, and a script
+    called many times is measured once."""
+
+    def __init__(self) -> None:
+        self.calls: dict[int, Size] = {}
+
+    def steps(self, steps: tuple[Step, ...]) -> Size:
+        ticks = items = 0
+        for step in steps:
+            size = self.step(step)
+            ticks, items = ticks + size.ticks, items + size.items
+        return Size(ticks, items)
+
+    def step(self, step: Step) -> Size:
+        if isinstance(step, TBlock):
+            after = [self.steps(r.body) for r in step.reactions]
+            ticks = step.length + max([a.ticks for a in after], default=0)
+            extra = sum(a.items or 1 for a in after)  # an empty reaction is one section
+            return Size(ticks, len(step.runs) + len(step.watches) + 1 + extra)
+        if isinstance(step, TRepeat):
+            body = self.steps(step.body)
+            n = step.count if step.kind == "count" else 1
+            return Size(body.ticks * n, body.items * n)
+        if isinstance(step, TIf):
+            then, orelse = self.steps(step.then), self.steps(step.orelse)
+            return Size(max(then.ticks, orelse.ticks), then.items + orelse.items)
+        if isinstance(step, TCall):
+            key = id(step.script)
+            if key not in self.calls:
+                self.calls[key] = self.steps(step.script.timeline)
+            return self.calls[key]
+        return Size(0, 1)  # an ending: a section of no ticks
+
+
+def measure(script: Script) -> Size:
+    """The size of ``script``'s expanded timeline, in time linear in the script's size."""
+    return _Measure().steps(script.timeline)
+
+
+def length(script: Script) -> int:
+    """The number of ticks :func:`expand` lays ``script`` out on, fully expanded."""
+    return measure(script).ticks
+
+
 class _Walk:
     """Places every step of a timeline, in order, on absolute ticks."""
 
-    def __init__(self) -> None:
+    def __init__(self, compact: bool) -> None:
         self.runs: list[Placed] = []
         self.watches: list[PlacedWatch] = []
         self.sections: list[Section] = []
         self.lanes: dict[str, None] = {}
+        self.compact = compact
+        self.cut = False
+
+    def full(self, offset: int) -> bool:
+        """Whether a compact layout has reached its limits (then it stops)."""
+        items = len(self.runs) + len(self.watches) + len(self.sections)
+        self.cut = self.cut or (self.compact and (offset >= MAX_TICKS or items >= MAX_ITEMS))
+        return self.cut
 
     def steps(self, steps: tuple[Step, ...], offset: int, path: str, label: str) -> int:
         """Place ``steps`` from ``offset``; return the offset after them."""
         prefix = f"{label} " if label else ""
         for step in steps:
+            if self.full(offset):
+                break
             if isinstance(step, TBlock):
                 offset = self.block(step, offset, path, label, prefix)
             elif isinstance(step, TRepeat):
-                if step.kind == "count":
+                if step.kind == "count" and self.compact:
+                    tag = f"{prefix}@repeat {step.count} (drawn once of {step.count})"
+                    offset = self.steps(step.body, offset, path, tag)
+                elif step.kind == "count":
                     for i in range(step.count):
                         tag = f"{prefix}@repeat {step.count} ({i + 1}/{step.count})"
                         offset = self.steps(step.body, offset, path, tag)
@@ -150,11 +228,22 @@ def expand(script: Script) -> Layout:
     labelled as a loop; both branches of an ``@if`` start at the same tick
     (the longer one sets where the script goes on), and so do a block's
     reactions, laid out after the block as possible paths; calls are inlined.
+
+    A timeline that would expand beyond :data:`MAX_TICKS` or :data:`MAX_ITEMS` is laid out
+    compactly instead: each counted repeat once, stopping at those limits.
     """
-    walk = _Walk()
-    length = walk.steps(script.timeline, 0, script.path, "")
+    size = measure(script)
+    walk = _Walk(compact=size.ticks > MAX_TICKS or size.items > MAX_ITEMS)
+    ticks = walk.steps(script.timeline, 0, script.path, "")
     return Layout(
-        tuple(walk.runs), tuple(walk.sections), length, tuple(walk.watches), tuple(walk.lanes)
+        tuple(walk.runs),
+        tuple(walk.sections),
+        ticks,
+        tuple(walk.watches),
+        tuple(walk.lanes),
+        walk.compact,
+        walk.cut,
+        size.ticks,
     )
 
 
