@@ -81,7 +81,7 @@ def _run_with(stand_in: object, script: Script) -> RunResult:
 
 
 def engine_overhead(script_arg: str, repeat: int) -> None:
-    script = load(resolve_script(script_arg), load_scene_names)
+    script = load(resolve_script(script_arg), loader=load_scene_names)
     # One recorded run gives the controls to replay; it is not timed (the recorder has its
     # own cost). Runs are deterministic, so every timed run steps the same physics.
     recorder = _StepRecorder()

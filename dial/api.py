@@ -46,7 +46,7 @@ def load(path: str | Path, *, scene: str | None = None) -> Script:
         override = None if scene is None else scene_option(scene)
     except SceneNotFoundError as e:
         raise OptionError(str(e)) from None
-    return parse_and_check(resolve_script(str(path)), load_scene_names, scene=override)
+    return parse_and_check(resolve_script(str(path)), loader=load_scene_names, scene=override)
 
 
 def check_options(

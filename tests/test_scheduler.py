@@ -257,7 +257,7 @@ def test_ctrl_c_stops_the_run_at_a_checkpoint_with_the_arm_held(tick: int) -> No
     # of a KeyboardInterrupt: the run ends as an interrupt (exit 130), logged, arm held.
     lane = " " * (tick - 1) + "#"
     text = ARM + HAND + f"arm  #====\npose {lane}\n"
-    script = check_text(text, "x.dial", origin=Path("x.dial"))
+    script = check_text(text, "x.dial")
     assert script is not None
     robot, log = FakeRobot(), EventLog()
     fake = FakeFactory(robot, {})

@@ -12,7 +12,6 @@ from __future__ import annotations
 import itertools
 from collections.abc import Collection, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
-from pathlib import Path
 from types import MappingProxyType
 from typing import NamedTuple
 
@@ -230,7 +229,7 @@ def run_fake(
     simulated time. Unpaced, it runs as ``dial run`` does, as fast as it can.
     """
     if isinstance(script, str):
-        checked = check_text(script, path, origin=Path(path))
+        checked = check_text(script, path)
         assert checked is not None
         script = checked
     robot = FakeRobot(period, fault_at, holds)

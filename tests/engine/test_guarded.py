@@ -76,7 +76,7 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> tuple[engine.RunResult, Rec
 
     setup.MujocoRobot = Capture  # type: ignore[misc]
     try:
-        result = engine.run(load(path, load_scene_names), engine.RunOptions())
+        result = engine.run(load(path, loader=load_scene_names), engine.RunOptions())
     finally:
         setup.MujocoRobot = original  # type: ignore[misc]
     return result, robots[0]

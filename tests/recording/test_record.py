@@ -110,7 +110,7 @@ def test_record_holds_the_run_and_leaves_the_log_unchanged(
 
 
 def test_observers_leave_the_physics_alone(short_script: Path, tmp_path: Path) -> None:
-    script = load(short_script, load_scene_names)
+    script = load(short_script, loader=load_scene_names)
     bare = run(script, RunOptions())
     sink = RerunSink(tmp_path / "run.rrd")
     watched = run(script, RunOptions(observers=[StateLog(), Recorder(sink, "short")]))
