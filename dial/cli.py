@@ -317,7 +317,7 @@ def cmd_teach(args: argparse.Namespace) -> int:
         require_display("--viewer")
     scene = _scene_option(args.scene)
     assert scene is not None
-    from dial.teach import teach
+    from dial.teach.app import teach
 
     snapshot = Path(args.snapshot) if args.snapshot else None
     return teach(scene, args.into, snapshot=snapshot, viewer=args.viewer)
@@ -330,7 +330,7 @@ def cmd_world(args: argparse.Namespace) -> int:
         _plot_usage("--picture")
     scene = _scene_option(args.scene)
     assert scene is not None
-    from dial.teach import world
+    from dial.teach.app import world
 
     text, frames = world(scene, Path(args.picture) if args.picture else None)
     sys.stdout.write(text)

@@ -36,9 +36,8 @@ class Parts:
         gbody = model.geom_bodyid
         robot = model.body_rootid[gbody] == root
         hand = np.array([bodies[b].startswith("hand_") for b in gbody])
-        names = tuple(
-            model.geom(g).name or f"{bodies[gbody[g]] or 'world'}#{g}" for g in range(model.ngeom)
-        )
+        # An unnamed geom goes by its body's name (the hand's link geoms are unnamed).
+        names = tuple(model.geom(g).name or bodies[gbody[g]] or "world" for g in range(model.ngeom))
         return cls(
             robot=robot,
             arm=robot & ~hand,

@@ -25,6 +25,8 @@ from dial.teach.sim import Sim
 
 WIDTH, HEIGHT = 1280, 960  # --picture
 AXIS = 0.05  # m: the length of a drawn frame axis
+AZIMUTH, ELEVATION = 135.0, -32.0  # deg: from the front right of the table, above it
+GHOST = 0.25  # the robot's opacity in --picture, so that frames behind it show
 COLOURS = ("#e41a1c", "#2ca02c", "#1f5fd6")  # x, y, z
 EXTRA = "pip install 'dial[plot]'"
 
@@ -56,7 +58,7 @@ def _fit_camera(points: FloatArray, fovy: float, size: tuple[int, int]) -> Camer
     """The task camera's direction, backed off until every point is inside the picture."""
     lo, hi = points.min(axis=0), points.max(axis=0)
     centre = tuple(float(c) for c in (lo + hi) / 2)
-    camera = Camera((centre[0], centre[1], centre[2]), 0.8, 160.0, -28.0)
+    camera = Camera((centre[0], centre[1], centre[2]), 0.8, AZIMUTH, ELEVATION)
     margin = np.array([0.08 * size[0], 0.08 * size[1]])
     for _ in range(40):
         px = project(camera, fovy, size, points)
@@ -108,19 +110,21 @@ def world_picture(sim: Sim, path: Path) -> int:
     points = np.array([p for p, _ in (*frames.values(), *objects.values())])
     fovy = float(sim.model.vis.global_.fovy)
     camera = _fit_camera(points, fovy, (WIDTH, HEIGHT))
-    renderer = Renderer(sim.model, camera, WIDTH, HEIGHT)
-    try:
-        image = renderer.render(sim.data)
-    finally:
-        renderer.close()
+    image, depth = _render(sim, camera)
     fig, ax = _figure(image)
     boxes: list[Box] = []
     for name, (pos, rot) in frames.items():
         ends = np.vstack([pos, pos + AXIS * rot.T])  # origin, then the x, y, z axis tips
         px = project(camera, fovy, (WIDTH, HEIGHT), ends)
+        hidden = _hidden(camera, depth, pos, px[0])
         for k in range(3):
-            ax.plot(*px[[0, k + 1]].T, color=COLOURS[k], linewidth=2.2, solid_capstyle="round")
-        _label(ax, boxes, px[0], name, "black", "white")
+            ax.plot(
+                *px[[0, k + 1]].T,
+                color=COLOURS[k],
+                linewidth=1.6 if hidden else 2.2,
+                linestyle=(0, (2, 2)) if hidden else "-",
+            )
+        _label(ax, boxes, px[0], f"{name} (hidden)" if hidden else name, "black", "white")
     for alias, (pos, _) in objects.items():
         px = project(camera, fovy, (WIDTH, HEIGHT), pos[None])[0]
         _label(ax, boxes, px, f"[{alias}]", "white", "#444444")
@@ -134,6 +138,36 @@ def world_picture(sim: Sim, path: Path) -> int:
     )
     _save(fig, path)
     return len(frames)
+
+
+def _render(sim: Sim, camera: Camera) -> tuple[Any, FloatArray]:
+    """The scene with the robot see-through, and the depth (m) of the scene without it, so
+    that a frame behind an object can be told from one behind the robot."""
+    model, robot = sim.model, sim.parts.robot  # this model copy is only drawn from now on
+    mats = np.unique(model.geom_matid[robot])
+    mats = mats[mats >= 0]
+    alpha = model.geom_rgba[robot, 3].copy(), model.mat_rgba[mats, 3].copy()
+    renderer = Renderer(model, camera, WIDTH, HEIGHT)
+    try:
+        model.geom_rgba[robot, 3], model.mat_rgba[mats, 3] = 0.0, 0.0  # not drawn at all
+        renderer.renderer.enable_depth_rendering()
+        depth = np.asarray(renderer.render(sim.data), dtype=np.float64)
+        renderer.renderer.disable_depth_rendering()
+        model.geom_rgba[robot, 3], model.mat_rgba[mats, 3] = alpha[0] * GHOST, alpha[1] * GHOST
+        return renderer.render(sim.data), depth
+    finally:
+        renderer.close()
+
+
+def _hidden(camera: Camera, depth: FloatArray, pos: FloatArray, px: FloatArray) -> bool:
+    """Whether the scene (not the robot) hides the point ``pos`` drawn at pixel ``px``."""
+    col, row = int(round(px[0])), int(round(px[1]))
+    if not (0 <= row < depth.shape[0] and 0 <= col < depth.shape[1]):
+        return False
+    az, el = math.radians(camera.azimuth), math.radians(camera.elevation)
+    forward = np.array([math.cos(el) * math.cos(az), math.cos(el) * math.sin(az), math.sin(el)])
+    along = float((pos - np.asarray(camera.position())) @ forward)
+    return bool(depth[row, col] < along - 0.01)
 
 
 def _label(ax: Any, boxes: list[Box], origin: Sequence[float], text: str, fg: str, bg: str) -> None:
