@@ -24,10 +24,11 @@ def teach(
     into: str | None,
     snapshot: Path | None = None,
     viewer: bool = False,
-    stdin: TextIO = sys.stdin,
-    out: TextIO = sys.stdout,
+    stdin: TextIO | None = None,
+    out: TextIO | None = None,
 ) -> int:
     """Run a teaching session; 0 when it ends with nothing left unwritten."""
+    stdin, out = stdin or sys.stdin, out or sys.stdout
     world, target = open_target(scene, into, Path.cwd())
     sim = Sim(world)
     session = Session(world, target, sim)
