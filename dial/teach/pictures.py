@@ -161,7 +161,7 @@ def _render(sim: Sim, camera: Camera) -> tuple[Any, FloatArray]:
 
 def _hidden(camera: Camera, depth: FloatArray, pos: FloatArray, px: FloatArray) -> bool:
     """Whether the scene (not the robot) hides the point ``pos`` drawn at pixel ``px``."""
-    col, row = int(round(px[0])), int(round(px[1]))
+    col, row = round(float(px[0])), round(float(px[1]))
     if not (0 <= row < depth.shape[0] and 0 <= col < depth.shape[1]):
         return False
     az, el = math.radians(camera.azimuth), math.radians(camera.elevation)

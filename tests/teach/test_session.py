@@ -45,10 +45,10 @@ def test_a_jog_moves_the_tool_exactly_by_the_step(session: Session) -> None:
     start = session.goal[0].copy()
     assert not np.allclose(start, p0)
     run(session, "jog 10 -20 30")
-    assert session.goal[0] == pytest.approx(start + [0.01, -0.02, 0.03], abs=1e-12)
+    assert session.goal[0] == pytest.approx(start + np.array([0.01, -0.02, 0.03]), abs=1e-12)
     assert np.linalg.norm(session.sim.tool()[0] - session.goal[0]) < 1e-3  # within the IK's 0.5 mm
     run(session, "jog tool z 10")  # the tool points down: tool +z is world -z
-    assert session.goal[0] == pytest.approx(start + [0.01, -0.02, 0.02], abs=1e-9)
+    assert session.goal[0] == pytest.approx(start + np.array([0.01, -0.02, 0.02]), abs=1e-9)
 
 
 def test_out_of_reach_leaves_the_robot_where_it_was(session: Session) -> None:

@@ -52,8 +52,9 @@ def test_a_change_keeps_every_comment_in_order_and_entries_in_place(tmp_path: Pa
     new_drop = lines.index("lid_drop = { pos = [0.4, -0.3, 0.5], rpy = [0, 180, 0] }")
     old_drop = old.index("lid_drop = { pos = [0.42, -0.3, 0.495], rpy = [0, 180, 0] }")
     assert new_drop - lines.index("[locations]") == old_drop - old.index("[locations]")
-    home = lines.index('home = { pos = [0.35, 0, 0.8], rpy = [0, 180, 0] }')
-    assert lines[home + 1] == 'near_cup = { object = "cup", pos = [0, -0.1, 0.2], rpy = [0, 90, 0] }'
+    home = lines.index("home = { pos = [0.35, 0, 0.8], rpy = [0, 180, 0] }")
+    near = 'near_cup = { object = "cup", pos = [0, -0.1, 0.2], rpy = [0, 90, 0] }'
+    assert lines[home + 1] == near
     pinch = lines.index("[poses.pinch]")
     assert lines[pinch + 1 : pinch + 4] == ["middle = { mcp = 20 }", "thumb = { mcp = 10 }", ""]
     assert lines[pinch - 2 : pinch] == ["thumb = [0, -20, 0, 0]", ""]
@@ -126,14 +127,14 @@ def test_shared_and_base_names_are_refused_with_the_reason(tmp_path: Path) -> No
         check_name(target, (), "poses", "open_hand", True)
     assert "pose 'open_hand' is defined in the shared hand poses (hand_poses.toml)" in str(e.value)
     assert "choose another name" in str(e.value)
-    with pytest.raises(NameClash, match="location 'home' is defined in pour.toml, which mine"):
+    with pytest.raises(NameClash, match=r"location 'home' is defined in pour\.toml, which mine"):
         check_name(target, (), "locations", "home", True)
     assert check_name(target, (), "locations", "fresh", False) == ""
 
 
 def test_own_and_session_names_are_replaced_only_when_asked(tmp_path: Path) -> None:
     _, target = open_target(str(pour_copy(tmp_path)), None, tmp_path)
-    with pytest.raises(NameClash, match="already defined in pour_copy.toml; add 'replace'"):
+    with pytest.raises(NameClash, match=r"already defined in pour_copy\.toml; add 'replace'"):
         check_name(target, (), "locations", "home", False)
     assert "replaces the location" in check_name(target, (), "locations", "home", True)
     # pour.toml's own prepit shadows the shared one: it is the file's to replace.
