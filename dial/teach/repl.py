@@ -95,7 +95,7 @@ def interactive(session: Session, after: Hook | None) -> int:
             print(f"error: {e}")
             continue
         except KeyboardInterrupt:
-            print("\ninterrupted")
+            print("\ninterrupted; the robot is back where it was before the command")
             continue
         if reply is not None:
             print(reply.text)

@@ -179,7 +179,7 @@ class Sim:
             blocked = np.abs(self.arm_q() - self.arm_target).max()
             if blocked > math.radians(1.0):
                 raise Collision(f"the arm is blocked {math.degrees(blocked):.1f} deg short")
-        except Collision:
+        except (Collision, KeyboardInterrupt):  # Ctrl-C at a terminal stops the motion too
             self.restore(before)
             raise
 
@@ -226,8 +226,13 @@ class Sim:
     def go_limp(self, mask: int, seconds: float) -> None:
         """Make the masked joints back-drivable for ``seconds``, then hold where they came to."""
         bits = [k for k in range(16) if mask >> k & 1]
-        self.limp[bits] = True
-        self.run_for(seconds)
-        self.hand_target[bits] = self.hand_q()[bits]
-        self.limp[bits] = False
-        self._checked(iter(()))
+
+        def periods() -> Iterable[None]:
+            self.limp[bits] = True
+            for _ in range(round(seconds / CONTROL_PERIOD)):
+                self.period()
+                yield None
+            self.hand_target[bits] = self.hand_q()[bits]
+            self.limp[bits] = False
+
+        self._checked(periods())
