@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 
 from dial.cli import main
-from dial.scene import load_world, worlds_dir
+from dial.scene import load_world
 from dial.teach.commands import SPECS
 
 DIAL = [sys.executable, "-m", "dial.cli"]
@@ -72,17 +72,6 @@ def dial(*args: str, stdin: str = "", cwd: Path | None = None) -> subprocess.Com
     )
 
 
-def pour_copy(tmp_path: Path) -> Path:
-    """pour.toml in a temporary directory, its [scene] paths made absolute."""
-    worlds = worlds_dir()
-    text = (worlds / "pour.toml").read_text(encoding="utf-8")
-    text = text.replace('"../scene_pour.xml"', f'"{(worlds.parent / "scene_pour.xml").as_posix()}"')
-    text = text.replace('"hand_poses.toml"', f'"{(worlds / "hand_poses.toml").as_posix()}"')
-    path = tmp_path / "pour_copy.toml"
-    path.write_text(text, encoding="utf-8")
-    return path
-
-
 def test_a_scripted_session_teaches_names_that_a_new_script_runs_with(tmp_path: Path) -> None:
     taught = tmp_path / "taught.toml"
     done = dial("teach", "--scene", "pour", "--into", str(taught), stdin=SESSION)
@@ -113,8 +102,10 @@ def test_a_scripted_session_teaches_names_that_a_new_script_runs_with(tmp_path: 
     assert grab["outcome"] == "done" and min(grab["data"]["forces"].values()) >= 8.0
 
 
-def test_write_without_changes_leaves_the_file_byte_identical(tmp_path: Path) -> None:
-    path = pour_copy(tmp_path)
+def test_write_without_changes_leaves_the_file_byte_identical(
+    tmp_path: Path, pour_copy: Path
+) -> None:
+    path = pour_copy
     before = path.read_bytes()
     done = dial("teach", "--scene", str(path), stdin="jog z -10\nwrite\nquit\n")
     assert done.returncode == 0, done.stderr
@@ -123,8 +114,8 @@ def test_write_without_changes_leaves_the_file_byte_identical(tmp_path: Path) ->
     assert not (tmp_path / "pour_copy.toml.bak").exists()
 
 
-def test_a_change_keeps_the_comments_and_a_backup(tmp_path: Path) -> None:
-    path = pour_copy(tmp_path)
+def test_a_change_keeps_the_comments_and_a_backup(tmp_path: Path, pour_copy: Path) -> None:
+    path = pour_copy
     before = path.read_text()
     session = "jog z -20\nsave location low\nsave location home replace\nwrite\n"
     done = dial("teach", "--scene", str(path), stdin=session)
@@ -137,8 +128,10 @@ def test_a_change_keeps_the_comments_and_a_backup(tmp_path: Path) -> None:
     assert (tmp_path / "pour_copy.toml.bak").read_text() == before
 
 
-def test_end_of_input_with_names_not_written_exits_1_and_prints_them(tmp_path: Path) -> None:
-    path = pour_copy(tmp_path)
+def test_end_of_input_with_names_not_written_exits_1_and_prints_them(
+    tmp_path: Path, pour_copy: Path
+) -> None:
+    path = pour_copy
     before = path.read_bytes()
     done = dial("teach", "--scene", str(path), stdin="jog z -20\nsave location low\nquit\n")
     assert done.returncode == 1
@@ -227,8 +220,8 @@ def test_world_picture(tmp_path: Path) -> None:
     assert image.shape[:2] == (960, 1280)
 
 
-def test_world_of_a_taught_file(tmp_path: Path) -> None:
-    shutil.copy(pour_copy(tmp_path), tmp_path / "base.toml")
+def test_world_of_a_taught_file(tmp_path: Path, pour_copy: Path) -> None:
+    shutil.copy(pour_copy, tmp_path / "base.toml")
     (tmp_path / "mine.toml").write_text(
         'extends = "base.toml"\n[locations]\nhere = { object = "lid", pos = [0, 0, 0.1], '
         'rpy = [0, 180, 0], axes = "world" }\n'

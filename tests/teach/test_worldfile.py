@@ -20,24 +20,16 @@ from dial.teach.worldfile import (
 WORLDS = worlds_dir()
 
 
-def pour_copy(tmp_path: Path) -> Path:
-    """pour.toml in a temporary directory, its [scene] paths made absolute."""
-    text = (WORLDS / "pour.toml").read_text(encoding="utf-8")
-    text = text.replace('"../scene_pour.xml"', f'"{(WORLDS.parent / "scene_pour.xml").as_posix()}"')
-    text = text.replace('"hand_poses.toml"', f'"{(WORLDS / "hand_poses.toml").as_posix()}"')
-    path = tmp_path / "pour_copy.toml"
-    path.write_text(text, encoding="utf-8")
-    return path
-
-
 def test_rendering_nothing_is_byte_identical() -> None:
     for path in WORLDS.glob("*.toml"):
         text = path.read_text(encoding="utf-8")
         assert render(text, []) == text, path.name
 
 
-def test_a_change_keeps_every_comment_in_order_and_entries_in_place(tmp_path: Path) -> None:
-    path = pour_copy(tmp_path)
+def test_a_change_keeps_every_comment_in_order_and_entries_in_place(
+    tmp_path: Path, pour_copy: Path
+) -> None:
+    path = pour_copy
     before = path.read_text(encoding="utf-8")
     _, moved = location_entry("lid_drop", None, None, (0.4, -0.3, 0.5), (0, 180, 0), False)
     _, added = location_entry("near_cup", "cup", "pour_cup", (0, -0.1, 0.2), (0, 90, 0), False)
@@ -65,8 +57,10 @@ def test_a_change_keeps_every_comment_in_order_and_entries_in_place(tmp_path: Pa
     assert world.poses["pinch"].angles == {5: pytest.approx(math.radians(20)), 13: math.radians(10)}
 
 
-def test_replacing_a_pose_keeps_its_table_and_the_comments_above_it(tmp_path: Path) -> None:
-    path = pour_copy(tmp_path)
+def test_replacing_a_pose_keeps_its_table_and_the_comments_above_it(
+    tmp_path: Path, pour_copy: Path
+) -> None:
+    path = pour_copy
     before = path.read_text(encoding="utf-8")
     _, pose = pose_entry("prepit", {k: 5.0 for k in range(4)})  # index only
     after = render(before, [pose])
@@ -90,8 +84,8 @@ def test_entries_round_to_what_is_written() -> None:
     assert pose.mask == 0x800F
 
 
-def test_write_is_atomic_and_keeps_a_backup(tmp_path: Path) -> None:
-    path = pour_copy(tmp_path)
+def test_write_is_atomic_and_keeps_a_backup(tmp_path: Path, pour_copy: Path) -> None:
+    path = pour_copy
     old = path.read_bytes()
     _, entry = location_entry("spot", None, None, (0.5, 0, 0.7), (0, 180, 0), False)
     backup = write_world(path, render(old.decode(), [entry]))
@@ -100,8 +94,8 @@ def test_write_is_atomic_and_keeps_a_backup(tmp_path: Path) -> None:
     assert sorted(p.name for p in tmp_path.iterdir()) == ["pour_copy.toml", "pour_copy.toml.bak"]
 
 
-def test_text_that_would_not_load_is_not_written(tmp_path: Path) -> None:
-    path = pour_copy(tmp_path)
+def test_text_that_would_not_load_is_not_written(tmp_path: Path, pour_copy: Path) -> None:
+    path = pour_copy
     old = path.read_bytes()
     bad = old.decode().replace('lid_grasp = { object = "lid"', 'lid_grasp = { object = "hat"')
     with pytest.raises(WriteError, match=r"pour_copy.toml: locations.lid_grasp.object"):
@@ -132,8 +126,10 @@ def test_shared_and_base_names_are_refused_with_the_reason(tmp_path: Path) -> No
     assert check_name(target, (), "locations", "fresh", False) == ""
 
 
-def test_own_and_session_names_are_replaced_only_when_asked(tmp_path: Path) -> None:
-    _, target = open_target(str(pour_copy(tmp_path)), None, tmp_path)
+def test_own_and_session_names_are_replaced_only_when_asked(
+    tmp_path: Path, pour_copy: Path
+) -> None:
+    _, target = open_target(str(pour_copy), None, tmp_path)
     with pytest.raises(NameClash, match=r"already defined in pour_copy\.toml; add 'replace'"):
         check_name(target, (), "locations", "home", False)
     assert "replaces the location" in check_name(target, (), "locations", "home", True)
