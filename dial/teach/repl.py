@@ -90,6 +90,7 @@ def interactive(session: Session, after: Hook | None) -> int:
         try:
             if strip_comment(line) == "quit" and session.unsaved and not _confirm_quit(session):
                 continue
+            # Past the question (or with nothing to lose), quit is quit!.
             reply = _one(session, "quit!" if strip_comment(line) == "quit" else line, after)
         except DialError as e:  # a command that could not be done; nothing changed
             print(f"error: {e}")

@@ -240,8 +240,8 @@ class Session:
 
     # -- saving ---------------------------------------------------------------------------------
     def _save(self, entry: Saved, note: str, world: World) -> str:
-        self.saved = (*(e for e in self.saved if e.name != entry.name or e.table != entry.table),)
-        self.saved = (*self.saved, entry)
+        key = (entry.table, entry.name)
+        self.saved = (*(e for e in self.saved if (e.table, e.name) != key), entry)
         self._set_world(world)
         return f"saved {entry.text().rstrip()}{note}\n(not written yet: 'write' writes it)"
 

@@ -138,3 +138,13 @@ def test_where_lists_contacts(session: Session) -> None:
     run(session, "jog z -20")  # the index tip onto the block's top
     where = run(session, "where")
     assert "contacts:\n  hand_index_distal - surface_block (surface_block)" in where
+
+
+def test_tab_completion_offers_commands_and_the_scenes_names(session: Session) -> None:
+    from dial.teach.repl import completions
+
+    words = completions(session)
+    for word in ("jog", "save", "relative-to", "above_block", "to_block", "block", "thumb"):
+        assert word in words
+    run(session, "save location fresh")
+    assert "fresh" in completions(session)  # a saved name completes at once
