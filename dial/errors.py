@@ -9,6 +9,11 @@ class DialError(Exception):
     """Root of every error the package raises on purpose."""
 
 
+class OptionError(DialError):
+    """An option (of ``dial run``, or of :func:`dial.run`) out of its range or unusable:
+    a usage error, exit status 2. The message names the option and what was expected."""
+
+
 @dataclass(frozen=True, order=True)
 class Span:
     """A place in a source file: 1-based line and column, ``end_col`` exclusive."""

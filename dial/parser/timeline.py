@@ -43,10 +43,49 @@ class Run:
 
 
 @dataclass(frozen=True)
+class Watch:
+    """A watched span: ``event`` sensed every control period of block ticks start..end."""
+
+    event: str
+    line: int
+    start: int
+    end: int
+    span: Span = field(default=Span(0, 0, 0), compare=False)
+
+
+@dataclass(frozen=True)
 class TBlock:
     line: int
     length: int
     runs: tuple[Run, ...]  # ordered by start tick, then line: the order runs start in
+    watches: tuple[Watch, ...] = ()  # in (start, line) order
+    reactions: tuple[TOn, ...] = ()  # in file order
+
+
+@dataclass(frozen=True)
+class TOn:
+    """``@on COND`` ... ``@end``: the reaction to a monitor of the block it follows."""
+
+    condition: Condition
+    body: tuple[Step, ...]
+    line: int
+
+
+@dataclass(frozen=True)
+class TResume:
+    line: int
+
+
+@dataclass(frozen=True)
+class TRetry:
+    max: int
+    line: int
+
+
+@dataclass(frozen=True)
+class TAbort:
+    message: str
+    line: int
 
 
 @dataclass(frozen=True)
@@ -73,7 +112,7 @@ class TCall:
     line: int
 
 
-Step = TBlock | TRepeat | TIf | TCall
+Step = TBlock | TRepeat | TIf | TCall | TResume | TRetry | TAbort
 
 
 @dataclass(frozen=True)
@@ -147,7 +186,7 @@ def expand(script: Script) -> Layout:
                 then_end = walk(step.then, offset, path, f"{prefix}@if {step.condition}")
                 else_end = walk(step.orelse, offset, path, f"{prefix}@else ({step.condition})")
                 offset = max(then_end, else_end)
-            else:
+            elif isinstance(step, TCall):
                 prefix = f"{label} " if label else ""
                 offset = walk(
                     step.script.timeline, offset, step.script.path, f"{prefix}@call {step.target}"

@@ -34,7 +34,7 @@ def deg_text(angles: Iterable[float]) -> str:
 
 def matrix_rpy(rot: FloatArray) -> tuple[float, float, float]:
     """Roll, pitch, yaw (deg) with ``rot = Rz(yaw) Ry(pitch) Rx(roll)``, the inverse of
-    :func:`dial.primitives.context.rpy_matrix`.
+    :func:`dial.geometry.rpy_matrix`.
 
     Of the two solutions, the one with the smaller roll and yaw is taken (a hand pointing
     down is ``[0, 180, 0]``, not ``[180, 0, 180]``); at pitch +-90 deg yaw is taken as 0.
@@ -66,7 +66,7 @@ def relative(
     pos: FloatArray, rot: FloatArray, frame_pos: FloatArray, frame_rot: FloatArray, world_axes: bool
 ) -> tuple[FloatArray, FloatArray]:
     """A pose in an object's frame (``world_axes``: offset from its origin, world axes), so that
-    :func:`dial.primitives.context.location_pose` gives ``pos``, ``rot`` back."""
+    :func:`dial.geometry.location_pose` gives ``pos``, ``rot`` back."""
     if world_axes:
         return pos - frame_pos, rot
     return frame_rot.T @ (pos - frame_pos), frame_rot.T @ rot

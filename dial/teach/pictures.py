@@ -18,7 +18,7 @@ import numpy as np
 
 from dial.backend.snapshot import FloatArray
 from dial.errors import DialError
-from dial.primitives.context import location_pose
+from dial.geometry import location_pose
 from dial.recording.geometry import Camera, task_camera
 from dial.recording.video import Renderer
 from dial.teach.sim import Sim

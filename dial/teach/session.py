@@ -18,10 +18,11 @@ from types import MappingProxyType
 import numpy as np
 
 from dial.backend.ik import IKError
+from dial.backend.snapshot import FloatArray
 from dial.errors import DialError
+from dial.geometry import rpy_matrix
 from dial.instructions.types import FINGERS
 from dial.primitives.arm import Planner
-from dial.primitives.context import rpy_matrix
 from dial.scene.valii import Appro, Depart, Drive, Move, Statement
 from dial.scene.world import JOINTS, World
 from dial.teach import report
@@ -161,7 +162,6 @@ class Session:
             p1, r1 = p0 + d, turn @ r0
         planner = Planner(self.sim.ctx, self.sim.arm_target)
         planner.line_to(p1, r1, "the jog's goal")
-        self._check_limits(planner)
         self.sim.move_arm(planner.segments)
         self.goal = (p1, r1)
         return report.tool(self.sim, self.goal)
@@ -172,14 +172,24 @@ class Session:
         for st, where in statements:
             if isinstance(st, Move | Appro) and st.location not in self.world.locations:
                 raise TeachError(_unknown("location", st.location, self.world.locations))
+            if isinstance(st, Drive):  # `dial run` stops a DRIVE at the limit; teaching refuses
+                self._check_drive(st, planner.q)
             planner.statement(st, where)
-            if isinstance(st, Drive):
-                self._check_limits(planner, st.joint - 1)
             goal = self._statement_goal(st, goal, planner)
-        self._check_limits(planner)
         self.sim.move_arm(planner.segments)
         self.goal = goal
         return report.tool(self.sim, self.goal)
+
+    def _check_drive(self, st: Drive, q: FloatArray) -> None:
+        j = st.joint - 1
+        lo, hi = self.sim.arm_range[j]
+        goal = q[j] + st.angle
+        if not lo <= goal <= hi:
+            raise TeachError(
+                f"refused: PUMA joint {st.joint} would go to {math.degrees(goal):.1f} deg, beyond "
+                f"its range {math.degrees(lo):.0f} to {math.degrees(hi):.0f} deg; the robot "
+                "stays where it was"
+            )
 
     def _statement_goal(self, st: Statement, goal: Pose3, planner: Planner) -> Pose3:
         """The tool pose a statement sends the arm to, as commanded (not as IK reached it)."""
@@ -190,20 +200,6 @@ class Session:
         if isinstance(st, Depart):
             return goal[0] - st.distance * goal[1][:, 2], goal[1]
         return self.sim.ik.fk(planner.q)
-
-    def _check_limits(self, planner: Planner, joint: int | None = None) -> None:
-        lo, hi = self.sim.arm_range[:, 0], self.sim.arm_range[:, 1]
-        for seg in planner.segments:
-            bad = np.flatnonzero((seg.q1 < lo - 1e-9) | (seg.q1 > hi + 1e-9))
-            if joint is not None:
-                bad = bad[bad == joint]
-            if len(bad):
-                j = int(bad[0])
-                raise TeachError(
-                    f"refused: PUMA joint {j + 1} would go to {math.degrees(seg.q1[j]):.1f} deg, "
-                    f"beyond its range {math.degrees(lo[j]):.0f} to {math.degrees(hi[j]):.0f} "
-                    "deg; the robot stays where it was"
-                )
 
     # -- hand -----------------------------------------------------------------------------------
     def _hand_goal(self, joints: Mapping[int, float], mask: int) -> str:

@@ -19,8 +19,9 @@ from dial.backend.driver import MujocoRobot
 from dial.backend.ik import ArmIK
 from dial.backend.model import ARM_HOME, RobotIndex, hand_ctrl, load_model
 from dial.backend.snapshot import FloatArray
-from dial.primitives.arm import Segment, smooth
-from dial.primitives.context import Context, location_pose, rpy_matrix
+from dial.geometry import location_pose, rpy_matrix, smooth
+from dial.primitives.arm import Segment
+from dial.primitives.context import Context
 from dial.scene.thread import find_threads
 from dial.scene.world import World
 from dial.teach.contacts import Parts, collision
@@ -96,12 +97,12 @@ class Sim:
         self.hand_target = data.qpos[ix.hand_qpos].copy()
         self.limp = np.zeros(16, dtype=bool)
         self.on_period: Callable[[], None] | None = None  # a live viewer's update
-        arm_joints = model.actuator_trnid[ix.arm_actuators, 0]
-        self.arm_range = model.jnt_range[arm_joints].copy()  # (6, 2) rad
-        self.hand_range = model.jnt_range[model.dof_jntid[ix.hand_dof]].copy()  # (16, 2) rad
         self._apply()
         mujoco.mj_forward(model, data)
+        # The planner of `dial run` reads the world, the IK and the joint ranges from here.
         self.ctx = Context(MujocoRobot(model, data), world, believed, self.ik)
+        self.arm_range = self.ctx.robot.arm_range  # (6, 2) rad
+        self.hand_range = self.ctx.robot.hand_range  # (16, 2) rad, mask order
         if settle:
             self.run_for(START_SETTLE_S)
 

@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from dial.primitives.context import location_pose
+from dial.geometry import location_pose
 from dial.teach.commands import parse_command
 from dial.teach.session import Session, TeachError
 from dial.teach.sim import Sim
