@@ -15,7 +15,7 @@ from typing import IO
 
 from dial.errors import DialError
 
-_DIGITS = 6
+DIGITS = 6
 
 Record = dict[str, object]
 
@@ -27,7 +27,7 @@ class LogError(DialError):
 def _float(value: float) -> float | None:
     if not math.isfinite(value):
         return None
-    return round(value, _DIGITS) + 0.0  # +0.0 turns -0.0 into 0.0
+    return round(value, DIGITS) + 0.0  # +0.0 turns -0.0 into 0.0
 
 
 def clean(value: object) -> object:
@@ -56,6 +56,7 @@ class EventLog:
         self._name = name
 
     def write(self, kind: str, /, **fields: object) -> Record:
+        """Append a record of ``kind``; its fields are cleaned (:func:`clean`)."""
         record: Record = {"kind": kind}
         for key, value in fields.items():
             kind_of = type(value)
@@ -65,6 +66,10 @@ class EventLog:
                 record[key] = value
             else:
                 record[key] = clean(value)
+        return self.append(record)
+
+    def append(self, record: Record) -> Record:
+        """Append a record whose values are clean already (the runner's hot records)."""
         self.records.append(record)
         if self._sink is not None:
             try:

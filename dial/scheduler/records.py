@@ -10,8 +10,10 @@ from __future__ import annotations
 
 from dial.parser.ast import Condition
 from dial.parser.script import Run
-from dial.scheduler.log import EventLog
-from dial.scheduler.types import Ended, Happening
+from dial.scheduler.log import DIGITS, EventLog, Record, clean
+from dial.scheduler.types import Ended, Happening, Outcome
+
+_OUTCOME_TEXT = {o: o.value for o in Outcome}  # a dict lookup is cheaper than Enum.value
 
 
 class Records:
@@ -24,11 +26,13 @@ class Records:
     def _whose(self, path: str) -> dict[str, str]:
         return {} if path == self.root else {"script": path}
 
+    # start and end are a run's two records: built directly, as the hot path they are.
     def start(self, path: str, run: Run, tick: int, t: float) -> None:
-        if path == self.root:
-            self.log.write("start", event=run.event, line=run.line, tick=tick, t=t)
-        else:
-            self.log.write("start", event=run.event, line=run.line, tick=tick, t=t, script=path)
+        record: Record = {"kind": "start", "event": run.event, "line": run.line, "tick": tick}
+        record["t"] = round(t, DIGITS) + 0.0
+        if path != self.root:
+            record["script"] = path
+        self.log.append(record)
 
     def end(self, path: str, run: Run, ended: Ended, tick: int, t: float) -> None:
         for warning in ended.warnings:
@@ -41,22 +45,27 @@ class Records:
                 message=warning,
                 **self._whose(path),
             )
-        fields: dict[str, object] = {"outcome": ended.outcome.value}
+        record: Record = {"kind": "end", "event": run.event, "line": run.line, "tick": tick}
+        record["t"] = round(t, DIGITS) + 0.0
+        record["outcome"] = _OUTCOME_TEXT[ended.outcome]
         if ended.message:
-            fields["message"] = ended.message
+            record["message"] = ended.message
         if ended.data:
-            fields["data"] = dict(ended.data)
+            record["data"] = clean(ended.data)
         if path != self.root:
-            fields["script"] = path
-        self.log.write("end", event=run.event, line=run.line, tick=tick, t=t, **fields)
+            record["script"] = path
+        self.log.append(record)
 
     def tick(
         self, tick: int, block_tick: int, t0: float, t1: float, stretch: int, preempted: bool
     ) -> None:
-        extra = {"preempted": True} if preempted else {}
-        self.log.write(
-            "tick", tick=tick, block_tick=block_tick, t0=t0, t1=t1, stretch=stretch, **extra
-        )
+        record: Record = {"kind": "tick", "tick": tick, "block_tick": block_tick}
+        record["t0"] = round(t0, DIGITS) + 0.0
+        record["t1"] = round(t1, DIGITS) + 0.0
+        record["stretch"] = stretch
+        if preempted:
+            record["preempted"] = True
+        self.log.append(record)
 
     def condition(self, path: str, cond: Condition, value: bool, tick: int, t: float) -> None:
         self.log.write(

@@ -11,7 +11,7 @@ from __future__ import annotations
 from collections import defaultdict
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Generic, NamedTuple
+from typing import Generic, NamedTuple, cast
 
 import trio
 
@@ -37,6 +37,7 @@ from dial.scheduler.types import (
 )
 
 ABORT_ON = frozenset({Outcome.TIMEOUT, Outcome.ERROR})
+OUTCOME_TEXT = {o: o.value for o in Outcome}  # a dict lookup is cheaper than Enum.value
 YIELD_EVERY = 64  # periods between trio checkpoints when not paced (other tasks, I/O)
 
 Progress = Callable[[int, float, list[str]], None]  # (tick, sim time, running events)
@@ -59,18 +60,34 @@ class ActiveRun(Generic[S]):
     )
 
     def __init__(
-        self, script: Script, info: RunInfo, prim: Primitive[S], periods: int, clock: int
+        self, script: Script, plan: RunPlan, prim: Primitive[S], periods: int, clock: int
     ) -> None:
-        run, event = info.run, info.event
-        self.script, self.info, self.prim = script, info, prim
+        self.script, self.info, self.prim = script, plan.info, prim
+        self.span, self.fixed, self.timeout = plan.span, plan.fixed, plan.timeout
         self.start_period, self.start_clock = periods, clock  # periods, tick-time periods
-        self.span = (run.exec_end - run.start + 1) * info.periods_per_tick  # executing, periods
-        self.fixed = event.instruction.length == "fixed"
-        timeout = event.args.get("timeout")
-        # Fixed-length runs end with their ticks; only indeterminate ones time out.
-        usable = not self.fixed and isinstance(timeout, int | float)
-        self.timeout: float | None = float(timeout) if usable else None  # type: ignore[arg-type]
         self.ended: Ended | None = None
+
+
+class RunPlan(NamedTuple):
+    """What a run's place in the script fixes, worked out once per run of the timeline."""
+
+    info: RunInfo
+    span: int  # its executing ticks, in periods
+    fixed: bool  # fixed-length: it ends with its last executing tick
+    timeout: float | None  # s; only indeterminate runs time out
+
+    @classmethod
+    def of(cls, info: RunInfo) -> RunPlan:
+        run, event = info.run, info.event
+        fixed = event.instruction.length == "fixed"
+        timeout = event.args.get("timeout")
+        usable = not fixed and isinstance(timeout, int | float)
+        return cls(
+            info,
+            (run.exec_end - run.start + 1) * info.periods_per_tick,
+            fixed,
+            float(timeout) if usable else None,  # type: ignore[arg-type]
+        )
 
 
 class _Plan(NamedTuple):
@@ -116,7 +133,8 @@ class TickLoop(Generic[S]):
         self.abort: RunAborted | None = None
         self._ending = False  # some run ended this period: stop it after the period
         self._plans: dict[int, _Plan] = {}
-        self._infos: dict[tuple[str, int], RunInfo] = {}
+        self._runs: dict[tuple[str, int], RunPlan] = {}
+        self._snap: S | None = None
         self.t0 = 0.0  # trio time at the first period, for pacing
 
     @property
@@ -142,12 +160,13 @@ class TickLoop(Generic[S]):
                     self.clock += 1
                     if fired := await self._period(stretched=False):
                         return self._preempt(script, block, fired, monitors, k, t0, stretch)
-                self._finish(k)
                 # An indeterminate run still going at the end of its last tick stretches it.
-                while any(a.ended is None and a.info.run.exec_end == k for a in self.active):
+                stretching = self._finish(k)
+                while stretching:
                     stretch += 1
                     if fired := await self._period(stretched=True):
                         return self._preempt(script, block, fired, monitors, k, t0, stretch)
+                    stretching = any(a.info.run.exec_end == k for a in self.active)
                 for watch in plan.watch_to.get(k, ()):
                     self._disarm(monitors, watch)
                 self._tick_done(k, t0, stretch, preempted=False)
@@ -177,41 +196,47 @@ class TickLoop(Generic[S]):
         self.records.tick(self.tick, k, t0, self.sim_time, stretch, preempted)
 
     # -- starting and sensing runs ------------------------------------------------------------
-    def _info(self, script: Script, run: Run, instant: bool = False) -> RunInfo:
+    def _run_plan(self, script: Script, run: Run) -> RunPlan:
         key = (script.path, id(run))
-        info = None if instant else self._infos.get(key)
-        if info is None:
+        plan = self._runs.get(key)
+        if plan is None:
             event = script.events[run.event]
-            info = RunInfo(event, run, script.path, self.n, self.period, instant)
-            if not instant:
-                self._infos[key] = info
-        return info
+            info = RunInfo(event, run, script.path, self.n, self.period)
+            plan = self._runs[key] = RunPlan.of(info)
+        return plan
+
+    def _snapshot(self) -> S:
+        """The robot's snapshot, taken once per state: starts, senses and the next period's
+        steps share it until the robot advances or a run's finish or stop writes a slot."""
+        if self._snap is None:
+            self._snap = self.robot.snapshot()
+        return self._snap
 
     def _start(self, script: Script, run: Run) -> None:
         """Start a run in line order; a sensing run happens at once."""
-        info = self._info(script, run)
-        prim = self.factory(info)
+        plan = self._run_plan(script, run)
+        prim = self.factory(plan.info)
         self.counts["runs"] += 1
         self.records.start(script.path, run, self.tick, self.sim_time)
-        if not isinstance(prim, Primitive):
-            self._sense(script, run, prim)
+        if plan.info.event.instruction.length == "zero":
+            self._sense(script, run, cast(Sensor[S], prim))
             return
-        active = ActiveRun(script, info, prim, self.periods, self.clock)
+        active = ActiveRun(script, plan, cast(Primitive[S], prim), self.periods, self.clock)
         self.active.append(active)  # from here on, its stop runs whatever happens
         try:
-            prim.start(self.robot.snapshot())
+            active.prim.start(self._snapshot())
         except DialError as e:
             self._end(active, Ended(Outcome.ERROR, str(e)), self.sim_time)
 
     def sense(self, script: Script, run: Run) -> None:
         """Sense a condition-only event now, with zero duration (no start record)."""
-        prim = self.factory(self._info(script, run, instant=True))
-        assert not isinstance(prim, Primitive), f"'{run.event}' is not a sensing instruction"
-        self._sense(script, run, prim)
+        info = RunInfo(script.events[run.event], run, script.path, self.n, self.period, True)
+        sensor = cast(Sensor[S], self.factory(info))
+        self._sense(script, run, sensor)
 
     def _sense(self, script: Script, run: Run, sensor: Sensor[S]) -> None:
         try:
-            ended = sensor.sense(self.robot.snapshot())
+            ended = sensor.sense(self._snapshot())
         except DialError as e:
             ended = Ended(Outcome.ERROR, str(e))
         self._record_end(script, run, ended, self.sim_time)
@@ -229,7 +254,7 @@ class TickLoop(Generic[S]):
 
     def _step(self, stretched: bool) -> tuple[Fired, ...]:
         """Step every active run in order, advance the robot, stop the runs that ended."""
-        snapshot = self.robot.snapshot()
+        snapshot = self._snapshot()
         periods = self.periods + 1
         t_end = periods * self.period
         tick, clock, n = self.tick, self.clock, self.n
@@ -248,6 +273,7 @@ class TickLoop(Generic[S]):
             if ended is not None:
                 self._end(a, ended, t_end)
         report = self.robot.advance()
+        self._snap = None
         self.periods = periods
         fired = () if report is None else self._report(report)
         if self.observe is not None:
@@ -267,19 +293,23 @@ class TickLoop(Generic[S]):
             )
         return report.fired
 
-    def _finish(self, k: int) -> None:
-        """End the fixed-length runs whose last executing tick ``k`` was."""
-        snapshot: S | None = None
+    def _finish(self, k: int) -> bool:
+        """End the fixed-length runs whose last executing tick ``k`` was; whether an
+        indeterminate one is still going, so that the tick stretches."""
+        stretching = False
         for a in self.active:
-            if a.fixed and a.ended is None and a.info.run.exec_end == k:
-                if snapshot is None:
-                    snapshot = self.robot.snapshot()
-                try:
-                    ended = a.prim.finish(snapshot)
-                except DialError as e:
-                    ended = Ended(Outcome.ERROR, str(e))
-                self._end(a, ended, self.sim_time)
+            if a.ended is not None or a.info.run.exec_end != k:
+                continue
+            if not a.fixed:
+                stretching = True
+                continue
+            try:
+                ended = a.prim.finish(self._snapshot())
+            except DialError as e:
+                ended = Ended(Outcome.ERROR, str(e))
+            self._end(a, ended, self.sim_time)
         self._raise_pending()
+        return stretching
 
     # -- ending runs ----------------------------------------------------------------------------
     def _end(self, a: ActiveRun[S], ended: Ended, t: float) -> None:
@@ -291,7 +321,7 @@ class TickLoop(Generic[S]):
 
     def _record_end(self, script: Script, run: Run, ended: Ended, t: float) -> None:
         self.latest[(script.path, run.event)] = ended.outcome
-        self.counts[ended.outcome.value] += 1
+        self.counts[OUTCOME_TEXT[ended.outcome]] += 1
         self.records.end(script.path, run, ended, self.tick, t)
 
     def _raise_pending(self) -> None:
@@ -306,6 +336,7 @@ class TickLoop(Generic[S]):
     def stop_runs(self, ended_only: bool = False) -> None:
         """Call ``stop`` of the (ended) active runs, in order: every one, even if one raises."""
         self._ending = False
+        self._snap = None  # a stop (or the finish before it) may have written a slot
         keep = [a for a in self.active if ended_only and a.ended is None]
         stopping = [a for a in self.active if not (ended_only and a.ended is None)]
         self.active = keep
@@ -371,5 +402,6 @@ class TickLoop(Generic[S]):
                 held |= a.info.event.effectors
         self.stop_runs(ended_only=True)
         self.robot.hold(frozenset(held))
+        self._snap = None
         self._tick_done(k, t0, stretch, preempted=True)
         return Preempted(on, self.tick)

@@ -14,6 +14,7 @@ from collections.abc import Collection, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import MappingProxyType
+from typing import NamedTuple
 
 import trio
 import trio.testing
@@ -36,8 +37,7 @@ from dial.scheduler.types import (
 )
 
 
-@dataclass(frozen=True)
-class FakeSnapshot:
+class FakeSnapshot(NamedTuple):
     periods: int
     commands: Mapping[str, float]
 
@@ -73,16 +73,18 @@ class FakeRobot:
         return self._period
 
     def snapshot(self) -> FakeSnapshot:
-        return FakeSnapshot(self.periods, MappingProxyType(dict(self.commands)))
+        return FakeSnapshot(self.periods, MappingProxyType(self.commands.copy()))
 
     def advance(self) -> Report | None:
-        self.trace.append(dict(self.commands))
-        self.periods += 1
-        fault = self.fault_at.get(self.periods)
+        self.trace.append(self.commands.copy())
+        self.periods = periods = self.periods + 1
+        fault = self.fault_at.get(periods) if self.fault_at else None
+        if not self.monitors:
+            return None if fault is None else Report(fault)
         fired = tuple(
-            Fired(key, self.periods * self._period, self.periods)
+            Fired(key, periods * self._period, periods)
             for key, m in self.monitors.items()
-            if (self.periods in self.conditions.get(m.event.name, ())) != m.negated
+            if (periods in self.conditions.get(m.event.name, ())) != m.negated
         )
         return Report(fault, (), fired) if fault is not None or fired else None
 
@@ -116,15 +118,18 @@ class Behaviour:
     message: str = ""
 
 
+_DEFAULT = Behaviour()
+
+
 class _Motion(Primitive[FakeSnapshot]):
     def __init__(self, robot: FakeRobot, info: RunInfo) -> None:
-        self.robot, self.effectors = robot, tuple(sorted(info.event.effectors))
+        self.commands, self.effectors = robot.commands, info.event.effectors
         self.stops = robot.stops
         self.name = info.event.name
 
     def step(self, snapshot: FakeSnapshot, now: Now) -> Ended | None:
         for effector in self.effectors:
-            self.robot.commands[effector] = now.progress
+            self.commands[effector] = now.progress
         return None
 
     def stop(self) -> None:
@@ -170,7 +175,7 @@ class FakeFactory:
 
     def __call__(self, info: RunInfo) -> Primitive[FakeSnapshot] | Sensor[FakeSnapshot]:
         name = info.event.name
-        behaviour = self.behaviours.get(name, Behaviour())
+        behaviour = self.behaviours.get(name, _DEFAULT)
         length = info.event.instruction.length
         if length == "fixed":
             return _Motion(self.robot, info)
