@@ -237,7 +237,9 @@ def _thread_turns(reader: Reader, value: Any) -> float:
     reader.keys(table, "thread", ["turns"], [])
     turns = reader.number(table["turns"], "thread.turns")
     if not 0.0 < turns <= MAX_TURNS:
-        raise reader.error("thread.turns", f"expected more than 0 and at most {MAX_TURNS:g}, got {turns:g}")
+        raise reader.error(
+            "thread.turns", f"expected more than 0 and at most {MAX_TURNS:g}, got {turns:g}"
+        )
     return turns
 
 
