@@ -150,16 +150,20 @@ def _check_watching(args: argparse.Namespace) -> None:
 def _watchers(args: argparse.Namespace, script: Script) -> list[Any]:
     """The run's observers: state log, rerun recording or stream, video, viewer."""
     watchers: list[Any] = []
+    if args.log_states or args.record or args.rerun:
+        from dial.recording.lanes import LanePlan
+
+        plan = LanePlan.from_script(script)  # the event lanes, in script order
     if args.log_states:
         from dial.recording.observers import StateLog
 
-        watchers.append(StateLog())
+        watchers.append(StateLog(plan=plan))
     if args.record or args.rerun:
         from dial.recording.observers import Recorder
         from dial.recording.rerun_sink import RerunSink
 
         sink = RerunSink(Path(args.record) if args.record else None, spawn=args.rerun)
-        watchers.append(Recorder(sink, Path(script.path).name))
+        watchers.append(Recorder(sink, Path(script.path).name, plan=plan))
     if args.video:
         from dial.recording.video import VideoWriter
 

@@ -12,8 +12,11 @@ import numpy as np
 from dial.backend.driver import MujocoRobot
 from dial.engine import RunResult, Watched
 from dial.recording.frames import RECORD_HZ, Frames, every
-from dial.recording.geometry import task_camera
+from dial.recording.geometry import workspace_eye
+from dial.recording.lanes import LanePlan
 from dial.recording.rerun_sink import RerunSink
+from dial.recording.task import TaskProbe
+from dial.scene.world import World
 from dial.scheduler.log import EventLog
 
 STATE_HZ = 25.0  # state records per second of simulated time (--log-states)
@@ -25,21 +28,45 @@ def object_bodies(model: mujoco.MjModel, bodies: list[str]) -> list[int]:
     return [int(mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, b)) for b in bodies]
 
 
-class Recorder:
-    """Records a run into a :class:`RerunSink`: frames at ``rate_hz``, every log record."""
+def open_scene(
+    sink: RerunSink,
+    model: mujoco.MjModel,
+    data: mujoco.MjData,
+    world: World,
+    title: str,
+    plan: LanePlan | None,
+) -> Frames:
+    """Send the scene and the layout to ``sink``; the frames to fill, with the task's probe."""
+    frames = Frames(model, TaskProbe(model, world.criteria, world.objects))
+    eye = workspace_eye(data, object_bodies(model, list(world.objects.values())))
+    assert frames.probe is not None
+    sink.scene(model, data, title, eye, world.objects, frames.probe.series, plan)
+    return frames
 
-    def __init__(self, sink: RerunSink, title: str, rate_hz: float = RECORD_HZ) -> None:
-        self.sink, self.title, self.rate_hz = sink, title, rate_hz
+
+class Recorder:
+    """Records a run into a :class:`RerunSink`: frames at ``rate_hz``, every log record.
+
+    ``plan`` (the script's lanes, :meth:`LanePlan.from_script`) orders the event lanes as in
+    the script and draws holds; without it lanes come in the order events first run.
+    """
+
+    def __init__(
+        self,
+        sink: RerunSink,
+        title: str,
+        rate_hz: float = RECORD_HZ,
+        plan: LanePlan | None = None,
+    ) -> None:
+        self.sink, self.title, self.rate_hz, self.plan = sink, title, rate_hz, plan
         self._seen = 0  # log records already sent
         self._tick = 0
 
     def begin(self, run: Watched) -> None:
         self.robot, self.log = run.robot, run.log
         model, data = run.robot.model, run.robot.data
-        self.frames = Frames(model)
+        self.frames = open_scene(self.sink, model, data, run.world, self.title, self.plan)
         self.every = every(self.rate_hz, run.robot.period)
-        camera = task_camera(data, object_bodies(model, list(run.world.objects.values())))
-        self.sink.scene(model, data, self.title, camera)
         self._capture(0, 0)
 
     def period(self, periods: int, tick: int) -> None:
@@ -88,15 +115,19 @@ class StateLog:
     The one observer that writes: it adds records to the log, and only when asked.
     A record holds ``t``, ``tick``, the whole ``qpos`` (the arm, the hand, and every free
     object) and the 32 tendon ``tension``s, which cannot be recomputed from positions.
+    With a ``plan``, a ``lanes`` record comes first, so that a replay draws the same lanes.
     """
 
-    def __init__(self, rate_hz: float = STATE_HZ) -> None:
-        self.rate_hz = rate_hz
+    def __init__(self, rate_hz: float = STATE_HZ, plan: LanePlan | None = None) -> None:
+        self.rate_hz, self.plan = rate_hz, plan
 
     def begin(self, run: Watched) -> None:
         self.robot: MujocoRobot = run.robot
         self.log: EventLog = run.log
         self.every = every(self.rate_hz, run.robot.period)
+        if self.plan is not None:
+            record = self.plan.as_record()
+            self.log.write(record.pop("kind"), **record)
         self._write(0, 0)
 
     def period(self, periods: int, tick: int) -> None:
