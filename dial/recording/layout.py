@@ -55,12 +55,13 @@ def blueprint(eye: tuple[Vec3, Vec3] | None, task: Sequence[tuple[str, str]]) ->
         rrb.TimeSeriesView(origin=ARM_JOINTS, name="arm joints (rad)", plot_legend=_NO_LEGEND),
         name="robot",
     )
-    right = rrb.Vertical(
-        rrb.Spatial3DView(origin="world", name="scene", eye_controls=controls),
-        _task(task),
-        rrb.Horizontal(tactile, robot),
-        row_shares=list(RIGHT_SHARES),
-    )
+    scene = rrb.Spatial3DView(origin="world", name="scene", eye_controls=controls)
+    rest = rrb.Horizontal(tactile, robot)
+    if task:
+        right = rrb.Vertical(scene, _task(task), rest, row_shares=list(RIGHT_SHARES))
+    else:  # a scene whose criteria all judge fits: nothing to plot while it runs
+        shares = [RIGHT_SHARES[0], RIGHT_SHARES[1] + RIGHT_SHARES[2]]
+        right = rrb.Vertical(scene, rest, row_shares=shares)
     return rrb.Blueprint(
         rrb.Horizontal(left, right, column_shares=list(COLUMN_SHARES)),
         rrb.TimePanel(timeline="sim_time", play_state="following", state="collapsed"),
@@ -93,6 +94,4 @@ def _task(task: Sequence[tuple[str, str]]) -> rrb.Container:
         rrb.TimeSeriesView(origin=f"{TASK}/{name}", name=title, plot_legend=_NO_LEGEND)
         for name, title in task
     ]
-    if not views:
-        views = [rrb.TimeSeriesView(origin=TASK, name="task (no measurable criteria)")]
     return rrb.Horizontal(*views, name="task")

@@ -4,13 +4,13 @@ and docs.
 ``python -m dial.recording.screenshot RUN.rrd SHOT.png [WIDTHxHEIGHT]`` runs
 ``rerun RUN.rrd --window-size WxH --screenshot-to SHOT.png`` in a virtual X server (Xvfb)
 that renders with Mesa's software Vulkan (lavapipe). Linux only; Debian packages ``xvfb``,
-``mesa-vulkan-drivers`` and ``libvulkan1``. The pointer is moved out of the window first,
-so that no tooltip covers the picture.
+``mesa-vulkan-drivers`` and ``libvulkan1``. The virtual screen is much larger than the
+window, so that its pointer (at the screen's centre) is outside the window and no tooltip
+covers the picture.
 """
 
 from __future__ import annotations
 
-import ctypes
 import ctypes.util
 import os
 import shutil
@@ -36,22 +36,6 @@ def missing() -> str | None:
     return None
 
 
-def _park_pointer(display: str, corner: tuple[int, int]) -> None:
-    """Move the X pointer to ``corner`` of the screen, outside the window."""
-    x11 = ctypes.cdll.LoadLibrary(ctypes.util.find_library("X11") or "libX11.so.6")
-    x11.XOpenDisplay.restype = ctypes.c_void_p
-    x11.XDefaultRootWindow.restype = ctypes.c_ulong
-    x11.XDefaultRootWindow.argtypes = [ctypes.c_void_p]
-    x11.XWarpPointer.argtypes = [ctypes.c_void_p, ctypes.c_ulong, ctypes.c_ulong]
-    x11.XWarpPointer.argtypes += [ctypes.c_int] * 6
-    x11.XCloseDisplay.argtypes = [ctypes.c_void_p]
-    dpy = x11.XOpenDisplay(display.encode())
-    if not dpy:
-        raise DialError(f"cannot open the virtual display {display}")
-    x11.XWarpPointer(dpy, 0, x11.XDefaultRootWindow(dpy), 0, 0, 0, 0, *corner)
-    x11.XCloseDisplay(dpy)
-
-
 def screenshot(rrd: Path, png: Path, size: tuple[int, int] = SIZE) -> None:
     """Open ``rrd`` in rerun's viewer at ``size`` (logical pixels) and save what it shows."""
     why = missing()
@@ -59,8 +43,8 @@ def screenshot(rrd: Path, png: Path, size: tuple[int, int] = SIZE) -> None:
         raise DialError(f"cannot take a screenshot: {why}")
     width, height = size
     read, write = os.pipe()
-    xvfb = subprocess.Popen(  # a screen larger than the window: the pointer can leave it
-        ["Xvfb", "-displayfd", str(write), "-screen", "0", f"{3 * width}x{3 * height}x24"],
+    xvfb = subprocess.Popen(  # the pointer, at the screen's centre, is outside the window
+        ["Xvfb", "-displayfd", str(write), "-screen", "0", f"{5 * width}x{2 * height}x24"],
         pass_fds=(write,),
         stdout=subprocess.DEVNULL,
         stderr=subprocess.DEVNULL,
@@ -69,8 +53,7 @@ def screenshot(rrd: Path, png: Path, size: tuple[int, int] = SIZE) -> None:
     try:
         with os.fdopen(read) as fd:
             display = ":" + fd.readline().strip()
-        _park_pointer(display, (3 * width - 1, 3 * height - 1))
-        env = {**os.environ, "DISPLAY": display, "RERUN_ANALYTICS": "off"}
+        env = {**os.environ, "DISPLAY": display}
         env.pop("WAYLAND_DISPLAY", None)
         cmd = ["rerun", str(rrd), "--port", "0", "--window-size", f"{width}x{height}"]
         done = subprocess.run(
