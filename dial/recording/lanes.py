@@ -217,7 +217,7 @@ class Lanes:
             for lane in self._held:
                 self._clear[lane] = (t, k + 1)
             self._held = {}
-        for lane, (t, k) in list(self._clear.items()):
+        for lane, (t, k) in sorted(self._clear.items(), key=lambda item: item[1]):
             if until is None or t <= until:
                 out.append(Phase(lane, None, t, k))
                 del self._clear[lane]
