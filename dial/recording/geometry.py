@@ -27,7 +27,8 @@ KINDS = {
 
 TASK_AZIMUTH, TASK_ELEVATION = 165.0, -18.0  # deg: from the front, a little from the side
 WORKSPACE_ABOVE = 0.3  # m above the objects that the hand works in
-EYE_ELEVATION = -25.0  # deg: the viewer's eye looks a little more down, into cups
+EYE_AZIMUTH, EYE_ELEVATION = 135.0, -25.0  # deg: more from the side and from above, so
+# that the hand shows beside the objects it works on, and into cups
 
 
 @dataclass(frozen=True)
@@ -61,7 +62,7 @@ def task_camera(data: mujoco.MjData, objects: list[int]) -> Camera:
 
 
 def workspace_eye(
-    data: mujoco.MjData, objects: list[int], fov_deg: float = 60.0
+    data: mujoco.MjData, objects: list[int], fov_deg: float = 75.0
 ) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
     """A viewer's eye on the task's workspace: the objects, and the hand as it works on
     them. ``(position, look_target)`` in m: from the task camera's direction, looking at a
@@ -72,7 +73,7 @@ def workspace_eye(
     target = (low + high) / 2.0 + np.array([0.0, 0.0, WORKSPACE_ABOVE / 2.0])
     radius = float(np.linalg.norm(high - low)) / 2.0 + WORKSPACE_ABOVE
     distance = radius / np.tan(np.radians(fov_deg) / 2.0)
-    az, el = np.radians(TASK_AZIMUTH), np.radians(EYE_ELEVATION)
+    az, el = np.radians(EYE_AZIMUTH), np.radians(EYE_ELEVATION)
     forward = np.array([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)])
     eye = target - distance * forward
     return (

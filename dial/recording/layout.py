@@ -26,7 +26,7 @@ COLUMN_SHARES = (2.0, 3.0)  # lanes and log | scene, tactile, task and robot
 LEFT_SHARES = (7.0, 3.0)  # lanes, log: 1000 px high fit about 15 lanes
 RIGHT_SHARES = (1.3, 0.45, 1.0)  # scene, task, tactile and robot
 # taxels: four 16x16 images two by two with their names, the depth scale, the colour key
-TACTILE_BOUNDS = ((-1.0, 60.0), (-1.0, 39.5))
+TACTILE_BOUNDS = ((-1.0, 59.0), (-1.0, 39.5))
 
 
 def blueprint(eye: tuple[Vec3, Vec3] | None, task: Sequence[tuple[str, str]]) -> rrb.Blueprint:

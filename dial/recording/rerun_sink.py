@@ -215,7 +215,7 @@ class RerunSink:
             rr.Boxes2D(mins=corners, sizes=[[16, 16]] * 4, colors=[(90, 90, 90)] * 4),
             static=True,
         )
-        names = [[x + 8.0, y + 17.2] for x, y in corners]
+        names = [[x + 8.0, y + 16.3] for x, y in corners]
         rec.log(
             f"{key}/names",
             rr.Points2D(names, radii=0.01, labels=list(FINGERS), show_labels=True),
@@ -234,19 +234,19 @@ class RerunSink:
         )
         swatches = [
             *zip(JOINTS, JOINT_COLORS, strict=True),
-            ("extensor: darker", _shade((200, 200, 200), EXTENSOR_SHADE)),
+            ("extensor darker", _shade((200, 200, 200), EXTENSOR_SHADE)),
             ("guard contact", GUARD_COLOR),
             ("touched point", POINT_COLOR),
         ]
-        rec.log(
+        rec.log(  # a bar of each colour, its name below it
             f"{key}/colours",
             rr.Boxes2D(
-                mins=[[45.0, i * 5.6] for i in range(len(swatches))],
-                sizes=[[2.0, 2.0]] * len(swatches),
+                mins=[[44.0, i * 5.0 + 0.3] for i in range(len(swatches))],
+                sizes=[[14.0, 0.6]] * len(swatches),
                 colors=[c for _, c in swatches],
                 labels=[name for name, _ in swatches],
                 show_labels=True,
-                radii=1.0,
+                radii=0.3,
             ),
             static=True,
         )
