@@ -54,11 +54,7 @@ ARM_COLORS += [(171, 71, 188)]
 TASK_COLOR = (255, 255, 255)
 GUARD_COLOR, POINT_COLOR, FIT_COLOR = (255, 80, 40), (40, 160, 255), (255, 200, 0, 140)
 GUARD_SHOWN_S = 2.0  # simulated seconds a guard's contact marker stays
-LEVELS = {
-    "info": rr.TextLogLevel.INFO,
-    "warn": rr.TextLogLevel.WARN,
-    "error": rr.TextLogLevel.ERROR,
-}
+LEVELS = {"info": "INFO", "warn": "WARN", "error": "ERROR"}  # rerun's TextLogLevel
 SOLID = rr.components.FillMode.Solid
 PLANE_THICKNESS = 1e-3  # m, to draw a fitted plane as a thin box
 VIEWER_PORT = 9876  # rerun's default
@@ -140,6 +136,9 @@ class RerunSink:
         self._bodies: list[str] = []
         self._task: list[str] = []
         self._lanes_seen: set[tuple[str, ...]] = set()
+        # Text lines and lane changes wait for the next batch of frames: one call per entity.
+        self._lines: list[tuple[int, int, str, str]] = []  # ns, tick, text, level
+        self._changes: dict[str, list[tuple[int, int, str]]] = {}  # lane: ns, tick, state
         self._points: dict[str, list[FloatArray]] = {}
         self._guards = 0
 
@@ -280,16 +279,35 @@ class RerunSink:
         for s, path in enumerate(self._task):
             scalars(path, batch.task[:, s : s + 1])
         self._phases(self.lanes.flush(float(batch.time_ns[-1]) * 1e-9))
+        self._send_events()
+
+    def _send_events(self) -> None:
+        """The text lines and lane changes gathered since the last batch, as columns."""
+
+        def index(rows: list[Any]) -> list[rr.TimeColumn]:
+            ns = np.array([r[0] for r in rows], dtype=np.int64)
+            return [
+                rr.TimeColumn("sim_time", duration=ns.astype("timedelta64[ns]")),
+                rr.TimeColumn("tick", sequence=[r[1] for r in rows]),
+            ]
+
+        if self._lines:
+            lines, self._lines = self._lines, []
+            texts = rr.TextLog.columns(text=[r[2] for r in lines], level=[r[3] for r in lines])
+            self.rec.send_columns(layout.LOG, indexes=index(lines), columns=texts)
+        changes, self._changes = self._changes, {}
+        for path, rows in changes.items():
+            states = rr.StateChange.columns(state=[r[2] for r in rows])
+            self.rec.send_columns(path, indexes=index(rows), columns=states)
 
     def record(self, record: Mapping[str, Any], tick: int, tips: FloatArray | None) -> None:
         """One log record at its own simulated time; ``tips`` (4, 3) m locate guard contacts."""
-        rec = self.rec
         t, tick = when(record, tick)
         self._at(t, tick)
         described = describe(record)
         if described is not None:
             text, level = described
-            rec.log(layout.LOG, rr.TextLog(text, level=LEVELS[level]))
+            self._lines.append((round(t * 1e9), tick, text, LEVELS[level]))
         kind = record["kind"]
         if kind == "end":
             self._sensed(record.get("data", {}))
@@ -372,6 +390,7 @@ class RerunSink:
 
     def close(self) -> None:
         self._phases(self.lanes.flush())
+        self._send_events()
         # A viewer closed mid-run must not keep the run from ending.
         self.rec.flush(timeout_sec=FLUSH_TIMEOUT_S if self.live else 1e38)
         self.rec.disconnect()

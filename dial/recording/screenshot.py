@@ -1,27 +1,37 @@
-"""A recording as rerun's own viewer shows it, without a display: a screenshot for tests
-and docs.
+"""A recording as rerun's own viewer shows it, without a display: screenshots for the tests
+and the docs.
 
 ``python -m dial.recording.screenshot RUN.rrd SHOT.png [WIDTHxHEIGHT]`` runs
 ``rerun RUN.rrd --window-size WxH --screenshot-to SHOT.png`` in a virtual X server (Xvfb)
-that renders with Mesa's software Vulkan (lavapipe). Linux only; Debian packages ``xvfb``,
-``mesa-vulkan-drivers`` and ``libvulkan1``. The virtual screen is much larger than the
+that renders with Mesa's software Vulkan (lavapipe): the whole viewer, its time cursor at the
+end of the run. Linux only; Debian packages ``xvfb``, ``mesa-vulkan-drivers`` and
+``libvulkan1``.
+
+``python -m dial.recording.screenshot RUN.rrd SHOT.png --at SECONDS [--view NAME]`` shows one
+view (default: the 3-D scene) at a simulated time instead. The ``rerun`` command cannot move
+the time cursor, so this drives a headless viewer through rerun's experimental
+``ViewerClient`` (rerun 0.41). The virtual screen is much larger than the
 window, so that its pointer (at the screen's centre) is outside the window and no tooltip
 covers the picture.
 """
 
 from __future__ import annotations
 
+import argparse
 import ctypes.util
 import os
 import shutil
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 from dial.errors import DialError
 
 SIZE = (1600, 1000)
 TIMEOUT_S = 180.0
+PORT = 9911  # the headless viewer's, away from rerun's default 9876
+NOTICES_S = 12.0
 
 
 def missing() -> str | None:
@@ -70,9 +80,37 @@ def screenshot(rrd: Path, png: Path, size: tuple[int, int] = SIZE) -> None:
         xvfb.wait()
 
 
+def view_at(rrd: Path, png: Path, seconds: float, view: str = "scene") -> None:
+    """Save the view named ``view`` of ``rrd`` at ``seconds`` of simulated time."""
+    from rerun.experimental import ViewerClient
+
+    client = ViewerClient.spawn(headless=True, port=PORT)
+    try:
+        client.open(str(rrd.resolve()))
+        client.set_time("sim_time", duration=seconds, play_state="paused")
+        time.sleep(NOTICES_S)  # wall time, for the picture only: start-up notices fade
+        views = {v.name: v.view_id for v in client.get_state().views}
+        if view not in views:
+            raise DialError(f"no view '{view}' (views: {', '.join(sorted(views))})")
+        client.save_screenshot(str(png.resolve()), view_id=views[view])
+    finally:
+        client.quit()
+
+
+def main(argv: list[str]) -> None:
+    ap = argparse.ArgumentParser(prog="python -m dial.recording.screenshot", description=__doc__)
+    ap.add_argument("rrd", type=Path)
+    ap.add_argument("png", type=Path)
+    ap.add_argument("size", nargs="?", default="1600x1000", help="the window, WIDTHxHEIGHT")
+    ap.add_argument("--at", type=float, help="one view at this simulated time (s)")
+    ap.add_argument("--view", default="scene", help="with --at: the view's name")
+    args = ap.parse_args(argv)
+    if args.at is not None:
+        view_at(args.rrd, args.png, args.at, args.view)
+    else:
+        width, height = (int(v) for v in args.size.split("x"))
+        screenshot(args.rrd, args.png, (width, height))
+
+
 if __name__ == "__main__":
-    arguments = sys.argv[1:]
-    if len(arguments) not in (2, 3):
-        sys.exit("usage: python -m dial.recording.screenshot RUN.rrd SHOT.png [WIDTHxHEIGHT]")
-    w, h = (int(v) for v in (arguments[2] if len(arguments) == 3 else "1600x1000").split("x"))
-    screenshot(Path(arguments[0]), Path(arguments[1]), (w, h))
+    main(sys.argv[1:])

@@ -16,7 +16,7 @@ import numpy as np
 
 from dial.backend.snapshot import FloatArray
 from dial.scene.criteria import Criterion
-from dial.scene.evaluate import reading
+from dial.scene.evaluate import reader
 from dial.scene.thread import find_threads
 
 
@@ -40,21 +40,20 @@ class TaskProbe:
         alias = {body: name for name, body in objects.items()}
         data = mujoco.MjData(model)
         mujoco.mj_forward(model, data)
-        self._criteria = [c for c in criteria if reading(c, model, data) is not None]
+        readers = [(c, reader(c, model)) for c in criteria]
+        self._readers = [read for _, read in readers if read is not None]
         self._threads = find_threads(model)
         self.series: list[Series] = []
-        for c in self._criteria:
-            r = reading(c, model, data)
-            assert r is not None
-            label = f"{alias.get(r.subject, r.subject)} {r.quantity}"
-            self.series.append(Series(c.name, label, r.unit))
+        for c, read in readers:
+            if read is not None:
+                r = read(data)
+                self.series.append(
+                    Series(c.name, f"{alias.get(r.subject, r.subject)} {r.quantity}", r.unit)
+                )
         self.series += [Series(f"{t.name}_turn", f"{t.name} turn", "deg") for t in self._threads]
 
     def sample(self, data: mujoco.MjData) -> FloatArray:
         """(len(series),) values now; ``data`` must be current (after a step or forward)."""
-        values = []
-        for c in self._criteria:
-            r = reading(c, self.model, data)
-            values.append(math.nan if r is None else r.value)
+        values = [read(data).value for read in self._readers]
         values += [math.degrees(t.turn(data)) for t in self._threads]
         return np.asarray(values, dtype=np.float64)

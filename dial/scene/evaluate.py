@@ -59,15 +59,35 @@ class Reading:
 
 def reading(criterion: Criterion, model: mujoco.MjModel, data: mujoco.MjData) -> Reading | None:
     """The criterion's measured quantity now; None for those that judge a fit's result."""
+    read = reader(criterion, model)
+    return None if read is None else read(data)
+
+
+def reader(
+    criterion: Criterion, model: mujoco.MjModel
+) -> Callable[[mujoco.MjData], Reading] | None:
+    """:func:`reading` with the criterion's bodies looked up once, to sample a run often."""
+    if isinstance(criterion, FractionInRegion):
+        bodies = _region_bodies(criterion, model)
+        site = model.site(criterion.region)
+        cup = model.body(model.site_bodyid[site.id]).name
+        return lambda d: Reading(cup, "contents", _inside(criterion, model, d, bodies)[0], "bodies")
     read = _READINGS.get(type(criterion))
-    return None if read is None else read(criterion, model, data)
+    return None if read is None else lambda d: read(criterion, model, d)
 
 
-def _inside(c: FractionInRegion, m: mujoco.MjModel, d: mujoco.MjData) -> tuple[int, int]:
-    """How many of the matching bodies lie in the region, and how many match."""
+def _region_bodies(c: FractionInRegion, m: mujoco.MjModel) -> list[int]:
     bodies = [i for i in range(m.nbody) if fnmatch.fnmatchcase(m.body(i).name, c.bodies)]
     if not bodies:
         raise ValueError(f"criterion {c.name}: no body matches '{c.bodies}'")
+    return bodies
+
+
+def _inside(
+    c: FractionInRegion, m: mujoco.MjModel, d: mujoco.MjData, bodies: list[int] | None = None
+) -> tuple[int, int]:
+    """How many of the matching bodies lie in the region, and how many match."""
+    bodies = _region_bodies(c, m) if bodies is None else bodies
     site = m.site(c.region)
     if site.type[0] != mujoco.mjtGeom.mjGEOM_BOX:
         raise ValueError(f"criterion {c.name}: region site '{c.region}' must be a box")
@@ -194,9 +214,6 @@ def _vector(fit: Mapping[str, Any], key: str, n: int) -> np.ndarray:
 
 
 _READINGS: dict[type, Callable[[Any, mujoco.MjModel, mujoco.MjData], Reading]] = {
-    FractionInRegion: lambda c, m, d: Reading(
-        m.body(m.site_bodyid[m.site(c.region).id]).name, "contents", _inside(c, m, d)[0], "bodies"
-    ),
     Upright: lambda c, m, d: Reading(c.body, "tilt", math.degrees(_tilt(c, m, d)), "deg"),
     Above: lambda c, m, d: Reading(c.body, "height", 1000 * _height(c, m, d), "mm"),
     FingerContacts: lambda c, m, d: Reading(c.body, "touch", len(_touching(c, m, d)), "fingers"),

@@ -112,7 +112,7 @@ def test_record_holds_the_run_and_leaves_the_log_unchanged(
 
     # Event lanes: running from a start, then the outcome over the same span, then held.
     lane = _rows(chunks, "/02_open", "StateChange:state")
-    assert lane[:3] == [["running"], ["done"], ["held"]] and lane[-1] in (None, [])
+    assert lane[:3] == [["running"], ["done"], ["held"]] and lane[-1] in ([], [""])  # ends it
     text = [t[0] for t in _rows(chunks, "/events/log", "TextLog:text")]
     assert "start to (line 9)" in text and any(t.startswith("end   grab done") for t in text)
     assert any(t.startswith(("OK", "FAILED")) for t in text)  # the criteria, at the end
