@@ -126,10 +126,8 @@ def _above(c: Above, m: mujoco.MjModel, d: mujoco.MjData, _: Results) -> tuple[b
 def _touching(c: FingerContacts, m: mujoco.MjModel, d: mujoco.MjData) -> set[str]:
     """The finger prefixes whose bodies touch the object."""
     target = m.body(c.body).id
-    n = d.ncon
-    b1 = m.geom_bodyid[d.contact.geom1[:n]]
-    b2 = m.geom_bodyid[d.contact.geom2[:n]]
-    others = np.concatenate([b2[b1 == target], b1[b2 == target]])
+    bodies = m.geom_bodyid[d.contact.geom[: d.ncon]]  # (ncon, 2): one read of the contacts
+    others = bodies[:, ::-1][bodies == target]
     names = {m.body(int(b)).name for b in set(others.tolist())}
     return {p for p in c.fingers if any(name.startswith(p) for name in names)}
 
