@@ -27,7 +27,7 @@ from dial.scene import load_scene_names
 
 
 def timed(script_arg: str, rrd: Path | None) -> tuple[float, RunResult]:
-    script = load(resolve_script(script_arg), load_scene_names)
+    script = load(resolve_script(script_arg), loader=load_scene_names)
     start = time.perf_counter()
     plan = LanePlan.from_script(script)  # as dial run --record does
     observers: list[Observer] = [Recorder(RerunSink(rrd), script_arg, plan=plan)] if rrd else []

@@ -1,4 +1,4 @@
-"""Observers of a run (see :class:`dial.engine.Observer`): the rerun recorder and the state log.
+"""The rerun recorder, an observer of a run (see :class:`dial.engine.Observer`).
 
 They sample on whole numbers of control periods, so a frame's time is exact simulated time
 and the same run gives the same frames.
@@ -7,21 +7,14 @@ and the same run gives the same frames.
 from __future__ import annotations
 
 import mujoco
-import numpy as np
 
-from dial.backend.driver import MujocoRobot
 from dial.engine import RunResult, Watched
+from dial.parser.lanes import LanePlan
 from dial.recording.frames import RECORD_HZ, Frames, every
 from dial.recording.geometry import workspace_eye
-from dial.recording.lanes import LanePlan
 from dial.recording.rerun_sink import RerunSink
 from dial.recording.task import TaskProbe
 from dial.scene.world import World
-from dial.scheduler.log import EventLog
-
-STATE_HZ = 25.0  # state records per second of simulated time (--log-states)
-STATE_DIGITS = 4  # 0.1 mm and 0.1 mrad: plenty to draw, and a third shorter than the default
-TENSION_DIGITS = 2  # 0.01 N
 
 
 def object_bodies(model: mujoco.MjModel, bodies: list[str]) -> list[int]:
@@ -37,11 +30,10 @@ def open_scene(
     plan: LanePlan | None,
 ) -> Frames:
     """Send the scene and the layout to ``sink``; the frames to fill, with the task's probe."""
-    frames = Frames(model, TaskProbe(model, world.criteria, world.objects))
+    probe = TaskProbe(model, world.criteria, world.objects)
     eye = workspace_eye(data, object_bodies(model, list(world.objects.values())))
-    assert frames.probe is not None
-    sink.scene(model, data, title, eye, world.objects, frames.probe.series, plan)
-    return frames
+    sink.scene(model, data, title, eye, world.objects, probe.series, plan)
+    return Frames(model, probe)
 
 
 class Recorder:
@@ -95,54 +87,6 @@ class Recorder:
             self.sink.frames(batch)
 
     def end(self, result: RunResult | None) -> None:
-        self._drain()
+        self._drain()  # the log's last record is the engine's summary
         self._send()
-        if result is not None:
-            summary = {
-                "kind": "summary",
-                "ok": result.ok,
-                "success": result.success,
-                "criteria": result.details,
-                "sim_time": result.summary.sim_time,
-            }
-            self.sink.record(summary, self._tick, None)
         self.sink.close()
-
-
-class StateLog:
-    """Writes ``state`` records into the log at ``rate_hz`` (``--log-states``), for replay.
-
-    The one observer that writes: it adds records to the log, and only when asked.
-    A record holds ``t``, ``tick``, the whole ``qpos`` (the arm, the hand, and every free
-    object) and the 32 tendon ``tension``s, which cannot be recomputed from positions.
-    With a ``plan``, a ``lanes`` record comes first, so that a replay draws the same lanes.
-    """
-
-    def __init__(self, rate_hz: float = STATE_HZ, plan: LanePlan | None = None) -> None:
-        self.rate_hz, self.plan = rate_hz, plan
-
-    def begin(self, run: Watched) -> None:
-        self.robot: MujocoRobot = run.robot
-        self.log: EventLog = run.log
-        self.every = every(self.rate_hz, run.robot.period)
-        if self.plan is not None:
-            record = self.plan.as_record()
-            self.log.write(record.pop("kind"), **record)
-        self._write(0, 0)
-
-    def period(self, periods: int, tick: int) -> None:
-        if periods % self.every == 0:
-            self._write(periods, tick)
-
-    def _write(self, periods: int, tick: int) -> None:
-        d, ix = self.robot.data, self.robot.index
-        self.log.write(
-            "state",
-            tick=tick,
-            t=periods * self.robot.period,
-            qpos=np.round(d.qpos, STATE_DIGITS),
-            tension=np.round(d.sensordata[ix.tension_sensors], TENSION_DIGITS),
-        )
-
-    def end(self, result: RunResult | None) -> None:
-        """Nothing to close: the log belongs to the run."""

@@ -11,6 +11,7 @@ from dial.parser import load
 from dial.recording.lanes import DEFAULT_TICK, LanePlan, Lanes, Phase
 from dial.resources import resolve_script
 from dial.scene import load_scene_names
+from tests.conftest import ROOT
 
 
 def _feed(lanes: Lanes, records: list[dict[str, Any]]) -> list[Phase]:
@@ -24,7 +25,7 @@ def _tick(k: int, t0: float, t1: float, block_tick: int, stretch: int = 0) -> di
 
 
 def test_the_plan_orders_lanes_as_the_script_and_groups_a_callee() -> None:
-    script = load(resolve_script("explore.dial"), load_scene_names)
+    script = load(resolve_script("explore.dial"), loader=load_scene_names)
     plan = LanePlan.from_script(script)
     assert plan.order[:8] == (
         ("reach",), ("point",), ("find",), ("give_up",), ("lift",), ("aside",), ("wide",),
@@ -121,3 +122,13 @@ def test_without_a_plan_lanes_come_in_the_order_events_first_run() -> None:
     assert lanes.path(("sub", "touch")) == ("02_sub", "01_touch")
     assert lanes.path(("alpha",)) == ("03_alpha",)
     assert lanes.width == DEFAULT_TICK  # no tick has ended yet
+
+
+def test_the_plan_has_lanes_for_watched_events_and_reactions() -> None:
+    """``~`` lines and ``@on`` bodies (DESIGN 2.7): each watched or reacting event a lane."""
+    script = load(ROOT / "tests" / "data" / "valid" / "reactions_nested.dial")
+    plan = LanePlan.from_script(script)
+    assert plan.order == (
+        ("reach",), ("touch",), ("pos",), ("back",), ("slow",), ("press",), ("snap",),
+        ("sub", "open"),
+    )  # fmt: skip
