@@ -65,7 +65,8 @@ def screenshot(rrd: Path, png: Path, size: tuple[int, int] = SIZE) -> None:
             display = ":" + fd.readline().strip()
         env = {**os.environ, "DISPLAY": display}
         env.pop("WAYLAND_DISPLAY", None)
-        cmd = ["rerun", str(rrd), "--port", "0", "--window-size", f"{width}x{height}"]
+        cmd = ["rerun", str(rrd), "--bind", "127.0.0.1", "--port", "0"]
+        cmd += ["--window-size", f"{width}x{height}"]
         done = subprocess.run(
             [*cmd, "--screenshot-to", str(png)],
             env=env,
