@@ -123,21 +123,38 @@ def _above(c: Above, m: mujoco.MjModel, d: mujoco.MjData, _: Results) -> tuple[b
     return height >= c.min_height, f"{height * 1000:.1f} mm above {c.site}"
 
 
-def _touching(c: FingerContacts, m: mujoco.MjModel, d: mujoco.MjData) -> set[str]:
-    """The finger prefixes whose bodies touch the object."""
+def _touching(
+    c: FingerContacts, m: mujoco.MjModel, d: mujoco.MjData, force: bool = False
+) -> tuple[set[str], float]:
+    """The finger prefixes whose bodies touch the object; with ``force``, also the normal
+    force they press it with in all (N; else 0)."""
     target = m.body(c.body).id
     bodies = m.geom_bodyid[d.contact.geom[: d.ncon]]  # (ncon, 2): one read of the contacts
-    others = bodies[:, ::-1][bodies == target]
-    names = {m.body(int(b)).name for b in set(others.tolist())}
-    return {p for p in c.fingers if any(name.startswith(p) for name in names)}
+    touching: set[str] = set()
+    total = 0.0
+    wrench = np.zeros(6)
+    for i in np.flatnonzero((bodies == target).any(axis=1)):
+        b1, b2 = bodies[i]
+        other = m.body(int(b2 if b1 == target else b1)).name
+        fingers = [p for p in c.fingers if other.startswith(p)]
+        if fingers:
+            touching.update(fingers)
+            if force:
+                mujoco.mj_contactForce(m, d, int(i), wrench)
+                total += abs(float(wrench[0]))  # the normal component, in the contact frame
+    return touching, total
 
 
 def _finger_contacts(
     c: FingerContacts, m: mujoco.MjModel, d: mujoco.MjData, _: Results
 ) -> tuple[bool, str]:
-    touching = _touching(c, m, d)
+    touching, force = _touching(c, m, d, force=not math.isinf(c.max_force))
     names = ", ".join(sorted(touching)) or "none"
-    return len(touching) >= c.min, f"{len(touching)} fingers touch ({names})"
+    detail = f"{len(touching)} fingers touch ({names})"
+    if math.isinf(c.max_force):
+        return len(touching) >= c.min, detail
+    held = len(touching) >= c.min and force <= c.max_force
+    return held, f"{detail} with {force:.1f} N (max {c.max_force:g} N)"
 
 
 def _plane_fit(c: PlaneFit, m: mujoco.MjModel, d: mujoco.MjData, r: Results) -> tuple[bool, str]:
@@ -214,7 +231,7 @@ def _vector(fit: Mapping[str, Any], key: str, n: int) -> np.ndarray:
 _READINGS: dict[type, Callable[[Any, mujoco.MjModel, mujoco.MjData], Reading]] = {
     Upright: lambda c, m, d: Reading(c.body, "tilt", math.degrees(_tilt(c, m, d)), "deg"),
     Above: lambda c, m, d: Reading(c.body, "height", 1000 * _height(c, m, d), "mm"),
-    FingerContacts: lambda c, m, d: Reading(c.body, "touch", len(_touching(c, m, d)), "fingers"),
+    FingerContacts: lambda c, m, d: Reading(c.body, "touch", len(_touching(c, m, d)[0]), "fingers"),
 }
 
 _MEASURES: dict[type, Callable[[Any, mujoco.MjModel, mujoco.MjData, Results], tuple[bool, str]]]
