@@ -172,7 +172,7 @@ def run(
         console = TerminalConsole() if sys.stdin.isatty() else LineConsole()
 
     with _log_sink(log) as sink:
-        watchers = _watchers(record, video, rerun, viewer, Path(script.path).name)
+        watchers = _watchers(record, video, rerun, viewer, script)
         options = RunOptions(
             tick=tick,
             speed=speed,
@@ -245,16 +245,18 @@ def _check_watching(
 
 
 def _watchers(
-    record: str | Path | None, video: str | Path | None, rerun: bool, viewer: bool, title: str
+    record: str | Path | None, video: str | Path | None, rerun: bool, viewer: bool, script: Script
 ) -> list[Observer]:
     """The observers behind ``record``, ``video``, ``rerun`` and ``viewer`` (checked)."""
     watchers: list[Observer] = []
     if record is not None or rerun:
+        from dial.parser.lanes import LanePlan
         from dial.recording.observers import Recorder
         from dial.recording.rerun_sink import RerunSink
 
         path = None if record is None else Path(record)
-        watchers.append(Recorder(RerunSink(path, spawn=rerun), title))
+        sink = RerunSink(path, spawn=rerun)  # the lanes in script order:
+        watchers.append(Recorder(sink, Path(script.path).name, plan=LanePlan.from_script(script)))
     if video is not None:
         from dial.recording.video import VideoWriter
 

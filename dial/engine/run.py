@@ -26,6 +26,7 @@ from dial.engine.result import RunResult, measure_criteria
 from dial.engine.setup import prepare
 from dial.engine.state import RunSettings, Saved
 from dial.errors import DialError
+from dial.parser.lanes import LanePlan
 from dial.parser.script import Script
 from dial.primitives import Context, make_factory
 from dial.scheduler.log import EventLog
@@ -94,7 +95,8 @@ def run(script: Script, options: RunOptions) -> RunResult:
                 tick=resume.tick,
                 t=resume.periods * robot.period,
             )
-        observers = ([StateLog()] if options.log_states else []) + list(options.observers)
+        states = [StateLog(lanes=LanePlan.from_script(script))] if options.log_states else []
+        observers = states + list(options.observers)
         begun: list[Observer] = []
         result: RunResult | None = None
         try:  # observers end also on an error: a recording keeps what was seen

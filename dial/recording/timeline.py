@@ -12,6 +12,7 @@ from pathlib import Path
 from typing import Any
 
 from dial.errors import DialError
+from dial.recording.lanes import lane_key
 
 Record = Mapping[str, Any]
 BAD_OUTCOMES = {"missed": "warn", "timeout": "error", "error": "error"}
@@ -53,8 +54,7 @@ def when(record: Record, tick: int) -> tuple[float, int]:
 def qualified_event(record: Record) -> str:
     """The event of a ``start`` or ``end`` record; a called script's events carry that
     script's name (``explore_surface.reach``), since event names repeat across scripts."""
-    script = record.get("script")
-    return f"{Path(script).stem}.{record['event']}" if script else str(record["event"])
+    return ".".join(lane_key(record))
 
 
 def describe(record: Record) -> tuple[str, str] | None:

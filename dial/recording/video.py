@@ -15,8 +15,8 @@ from typing import Any
 import mujoco
 
 from dial.engine import RunResult, Watched
+from dial.engine.observe import every
 from dial.errors import DialError
-from dial.recording.frames import every
 from dial.recording.geometry import Camera, task_camera
 from dial.recording.observers import object_bodies
 
