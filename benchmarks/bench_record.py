@@ -24,7 +24,7 @@ from dial.scene import load_scene_names
 
 
 def timed(script_arg: str, rrd: Path | None) -> tuple[float, RunResult]:
-    script = load(resolve_script(script_arg), load_scene_names)
+    script = load(resolve_script(script_arg), loader=load_scene_names)
     start = time.perf_counter()
     observers: list[Observer] = [Recorder(RerunSink(rrd), script_arg)] if rrd else []
     result = run(script, RunOptions(observers=observers))  # the recorder closes the file

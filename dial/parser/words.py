@@ -38,6 +38,12 @@ def tokenize(line: int, code: str, start: int) -> list[Param]:
 
     Raises :class:`WordError` at the first malformed parameter.
     """
+    if '"' not in code and "=" not in code:  # bare words only, as most directives have
+        out: list[Param] = []
+        for m in _WORD.finditer(code, start):
+            span = Span(line, m.start() + 1, m.end() + 1)
+            out.append(Param(None, (Word(m.group(), span),), False, span))
+        return out
     params: list[Param] = []
     i = start
     n = len(code)

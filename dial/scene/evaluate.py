@@ -76,14 +76,24 @@ def _finger_contacts(
 ) -> tuple[bool, str]:
     target = m.body(c.body).id
     touching: set[str] = set()
-    for contact in d.contact[: d.ncon]:
+    force = 0.0
+    wrench = np.zeros(6)
+    for i, contact in enumerate(d.contact[: d.ncon]):
         b1, b2 = m.geom_bodyid[contact.geom1], m.geom_bodyid[contact.geom2]
         if target not in (b1, b2):
             continue
         other = m.body(b2 if b1 == target else b1).name
-        touching.update(p for p in c.fingers if other.startswith(p))
+        fingers = [p for p in c.fingers if other.startswith(p)]
+        if fingers:
+            touching.update(fingers)
+            mujoco.mj_contactForce(m, d, i, wrench)
+            force += abs(float(wrench[0]))  # the normal component, in the contact frame
     names = ", ".join(sorted(touching)) or "none"
-    return len(touching) >= c.min, f"{len(touching)} fingers touch ({names})"
+    detail = f"{len(touching)} fingers touch ({names})"
+    if math.isinf(c.max_force):
+        return len(touching) >= c.min, detail
+    held = len(touching) >= c.min and force <= c.max_force
+    return held, f"{detail} with {force:.1f} N (max {c.max_force:g} N)"
 
 
 def _plane_fit(c: PlaneFit, m: mujoco.MjModel, d: mujoco.MjData, r: Results) -> tuple[bool, str]:
