@@ -72,7 +72,7 @@ def test_a_monitor_fires_in_the_period_its_condition_holds_and_preempts_the_bloc
     # The preempted runs' effectors hold where they are, in that period.
     assert result.robot.holds_at == [(23, frozenset({"arm", "middle"}))]
     # The interrupted tick is recorded as ending then; the rest of the block is skipped.
-    tick3 = [r for r in records(result, "tick") if r["tick"] == 3][0]
+    tick3 = next(r for r in records(result, "tick") if r["tick"] == 3)
     assert (tick3["t1"], tick3.get("preempted")) == (0.23, True)
 
 
