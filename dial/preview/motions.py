@@ -4,8 +4,8 @@ Fixed-length instructions run through their own primitives (:mod:`dial.primitive
 set-points going straight to the pose. The others are previewed at their start, at once:
 
 - ``guarded_move`` travels its line in small steps until the moving arm (the hand) or
-  finger first touches the world or an object, then stops there (outcome ``done``), or
-  travels its full ``max`` (``missed``). No ``press``.
+  finger first touches the world or an object other than what the hand holds, then stops
+  there (outcome ``done``), or travels its full ``max`` (``missed``). No ``press``.
 - ``grasp_force`` closes its joints until each finger touches something or reaches its
   limit; the free bodies the fingers touch are held from then on (``done`` when every
   tendon-watched finger touched something).
@@ -114,7 +114,7 @@ def guarded(scene: Scene, event: EventDef, check: Check) -> Report:
         s_next = min(length, s + STEP)
         lag = reach(s_next)
         check()
-        if scene.touching(groups):
+        if scene.touching(groups, held=False):
             _bisect(scene, before, reach, s, s_next, groups)
             return Report(Outcome.DONE)
         if lag > LAG:
@@ -145,7 +145,7 @@ def _bisect(
         mid = (lo + hi) / 2
         scene.restore(free)
         reach(mid)
-        if scene.touching(groups):
+        if scene.touching(groups, held=False):
             hi, touching = mid, scene.save()
         else:
             lo, free = mid, scene.save()

@@ -150,22 +150,22 @@ class Scene:
             out.append((int(a), int(b), -float(d)) if first else (int(b), int(a), -float(d)))
         return out
 
-    def touches(self, groups: Collection[int]) -> set[int]:
-        """The geoms that geoms of ``groups`` touch now: other robot parts, or anything not
-        held."""
-        held = self.held_bodies()
+    def touches(self, groups: Collection[int], held: bool = True) -> set[int]:
+        """The geoms that geoms of ``groups`` touch now (other robot parts included); without
+        ``held``, not those of what the hand holds."""
+        skip = set() if held else self.held_bodies()
         out: set[int] = set()
         for a, b, _ in self._contacts():
             for mine, other in ((a, b), (b, a)):
                 mine_in = self.group[mine] in groups
-                if mine_in and self.group[other] not in groups and self.root[other] not in held:
+                if mine_in and self.group[other] not in groups and self.root[other] not in skip:
                     out.add(other)
         return out
 
-    def touching(self, groups: Collection[int]) -> bool:
-        """Whether parts of ``groups`` touch the world or an object (not the robot, not what
-        it holds)."""
-        return any(self.group[g] < 0 for g in self.touches(groups))
+    def touching(self, groups: Collection[int], held: bool = True) -> bool:
+        """Whether parts of ``groups`` touch the world or an object (not the robot; without
+        ``held``, not what the hand holds)."""
+        return any(self.group[g] < 0 for g in self.touches(groups, held))
 
     def hits(self) -> list[Hit]:
         """The contacts that are problems (see docs/debugging.md), one per pair of parts."""

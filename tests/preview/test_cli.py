@@ -33,7 +33,7 @@ def test_a_location_moved_out_of_reach_fails_naming_it_and_its_line(
     far = tmp_path / "far.toml"
     far.write_text(
         'extends = "pour"\n\n[locations]\n'
-        'lid_grasp = { pos = [2.5, 0, 0.6], rpy = [0, 180, 0] }  # far beyond the table\n'
+        "lid_grasp = { pos = [2.5, 0, 0.6], rpy = [0, 180, 0] }  # far beyond the table\n"
     )
     assert main(["preview", "pour.dial", "--scene", str(far)]) == 1
     lines = capsys.readouterr().out.splitlines()

@@ -85,7 +85,8 @@ def test_a_location_out_of_reach_is_named_at_the_line_that_uses_it(tmp_path: Pat
     text = Path(script.path).read_text()
     run = f"{script.path}:{line_of(text, 'get_top  ')}:13: get_top: "
     assert not result.ok
-    assert result.problems[0].startswith(f"{run}APPRO lid_grasp (program get_top line 1, pour.toml:")
+    appro = f"{run}APPRO lid_grasp (program get_top line 1, pour.toml:"
+    assert result.problems[0].startswith(appro)
     assert result.problems[1].startswith(f"{run}location 'lid_grasp' (program get_top line 2, ")
     assert "is out of the arm's reach: the tool stays" in result.problems[1]
 
@@ -130,7 +131,8 @@ def test_a_branch_not_taken_gives_notes(edge: tuple[Path, list[str], list[str]])
     assert not any("DRIVE" in p for p in problems)
     assert len(notes) == 1 and notes[0].startswith(drive)
     assert f"edge.toml:{line_of(EDGE_WORLD, 'DRIVE')}): the target 185.8 deg is" in notes[0]
-    assert notes[0].endswith(f"; the @if touch of edge.dial:{line_of(EDGE, '@if')} is previewed false")
+    why = f"; the @if touch of edge.dial:{line_of(EDGE, '@if')} is previewed false"
+    assert notes[0].endswith(why)
 
 
 def walk(script_arg: str, scene: str | None = None) -> Walk:
