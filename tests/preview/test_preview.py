@@ -12,6 +12,7 @@ from dial.backend.driver import CONTROL_PERIOD
 from dial.engine.setup import script_world
 from dial.geometry import location_pose
 from dial.preview import preview
+from dial.preview.motions import grasp
 from dial.preview.places import statement_place
 from dial.preview.scene import Scene
 from dial.preview.walk import Walk
@@ -191,3 +192,27 @@ def test_fingers_that_collide_are_reported() -> None:
     assert result.problems
     assert all("the index finger and the middle finger collide" in p for p in result.problems)
     assert all(": twist_hand: " in p for p in result.problems)
+
+
+def test_a_grasp_holds_what_its_fingers_touch_and_what_lies_inside_it() -> None:
+    script = load("pour.dial")
+    scene = Scene(script_world(script))
+    ctx, robot = scene.ctx, scene.robot
+    pos, rot = ctx.location("pitcher_grasp")
+    robot.arm_target = ctx.arm_ik.solve(pos, rot, robot.arm_target, "pitcher_grasp")
+    for bit, angle in ctx.world.poses["prepit"].angles.items():
+        robot.hand_target[bit] = angle
+    scene.pose()
+    report = grasp(scene, script.events["grabpit"], lambda: None)
+    assert report.outcome.value == "done"
+    (grip,) = scene.held
+    names = {scene.model.body(b).name for b in grip.bodies}
+    balls = {n for n in names if n.startswith("pour_ball_")}
+    assert "pour_pitcher" in names and len(balls) == 36 and "pour_cup" not in names
+    assert grip.fingers == {1, 3}  # middle and thumb
+    # Lifted 10 cm, everything held goes up 10 cm with the hand.
+    ball = scene.model.body("pour_ball_07").id
+    before = scene.data.xpos[ball].copy()
+    robot.arm_target = ctx.arm_ik.solve(pos + np.array([0, 0, 0.1]), rot, robot.arm_target, "up")
+    scene.pose()
+    assert np.allclose(scene.data.xpos[ball] - before, [0, 0, 0.1], atol=0.003)
