@@ -75,8 +75,16 @@ def writable(path: str | Path, what: str) -> Path:
         why = f"'{path}' is a directory"
     elif not folder.is_dir():
         why = f"no such directory '{folder}'"
-    elif not os.access(folder, os.W_OK) or (target.exists() and not os.access(target, os.W_OK)):
-        why = f"permission denied: '{path}'"
+    else:  # try it: permissions, read-only file systems and /proc say no only to a write
+        existed = target.exists()
+        try:
+            with open(target, "a", encoding="utf-8"):
+                pass
+        except OSError as e:
+            why = f"{e.strerror or e}: '{path}'"
+        else:
+            if not existed:
+                target.unlink()
     if why is not None:
         raise DialError(f"cannot write {what}: {why}")
     return target

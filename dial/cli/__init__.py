@@ -7,6 +7,7 @@ Exit status: 0 success, 1 a script or run error (or a failed criterion), 2 a usa
 from __future__ import annotations
 
 import argparse
+import signal
 import sys
 from collections.abc import Sequence
 
@@ -42,6 +43,18 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
+    """Run the command line; ``argv`` None: this process's arguments, as the ``dial``
+    program (which then also ignores stop signals while Python shuts down)."""
+    status = _main(argv)
+    if argv is None:
+        # Everything is written and said; a second Ctrl-C must not turn the exit status
+        # into death by signal while the interpreter tears MuJoCo and trio down.
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            signal.signal(sig, signal.SIG_IGN)
+    return status
+
+
+def _main(argv: Sequence[str] | None) -> int:
     args = build_parser().parse_args(argv)
     try:
         status: int = args.func(args)

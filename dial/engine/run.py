@@ -21,7 +21,7 @@ from dial.backend.snapshot import Snapshot
 from dial.debug import Break, Console, Session
 from dial.disturb import Disturbance, parse_disturbance
 from dial.engine.debugging import session
-from dial.engine.observe import Observer, StateLog, Watched, fan_out
+from dial.engine.observe import Observer, StateLog, Watched, describe, fan_out, first_line
 from dial.engine.result import RunResult, measure_criteria
 from dial.engine.setup import prepare
 from dial.engine.state import RunSettings, Saved
@@ -123,8 +123,7 @@ def run(script: Script, options: RunOptions) -> RunResult:
             log.write("summary", **result.as_record())
             return result
         finally:
-            for observer in begun:
-                observer.end(result)
+            _end(begun, result)
 
 
 def _resume(
@@ -181,3 +180,16 @@ def _debugging(
         options.step,
         options.save_at,
     )
+
+
+def _end(observers: list[Observer], result: RunResult | None) -> None:
+    """End every observer, whatever the others do; then say which failed (the log and the
+    summary are written by then)."""
+    failed = []
+    for observer in observers:
+        try:
+            observer.end(result)
+        except Exception as e:
+            failed.append(f"{describe(observer)} failed: {first_line(e)}")
+    if failed:
+        raise DialError("; ".join(failed))
