@@ -25,6 +25,7 @@ Prints:
 from __future__ import annotations
 
 import argparse
+import tempfile
 import time
 from pathlib import Path
 from types import SimpleNamespace
@@ -117,10 +118,13 @@ def _record(script: Script) -> tuple[RunResult, _Replay]:
     return recorded, _Replay(recorder, recorded.world.model_path)
 
 
-def engine_overhead(script_arg: str, repeat: int) -> tuple[World, _Replay]:
+def engine_overhead(script_arg: str | Script, repeat: int) -> tuple[World, _Replay]:
     """Print the overhead figures; return the run's world and replay. Runs are deterministic,
     so every timed run steps the same physics as the recorded one."""
-    script = load(resolve_script(script_arg), loader=load_scene_names)
+    if isinstance(script_arg, Script):
+        script, script_arg = script_arg, Path(script_arg.path).name
+    else:
+        script = load(resolve_script(script_arg), loader=load_scene_names)
     _, replay = _record(script)
     model, data = replay.model, replay.data
 
@@ -184,6 +188,27 @@ def pour_physics(script_arg: str, today: _Replay, repeat: int) -> None:
         print(f"  {name:<16} {ms:8.1f} ms CPU per simulated s (best; {steps} steps)")
     print(f"  ratio before / today, median pair {ratios[len(ratios) // 2]:6.2f}   (target >= 3)")
     print(f"  before: {POUR_BEFORE.parent.name}/ (succeeded: {recorded.ok})")
+
+
+def watched_overhead(repeat: int) -> None:
+    """The overhead with a monitor armed all through pour's long block (it never fires):
+    the driver steps one physics step at a time and tests the condition after each."""
+    text = resolve_script("pour.dial").read_text(encoding="utf-8")
+    lines = text.splitlines()
+    last = max(i for i, line in enumerate(lines) if line.startswith("retract_arm "))
+    width = max(len(line) for line in lines[last - 8 : last + 1])
+    lines.insert(last + 1, "idle" + " " * 8 + "~" * (width - 12))
+    lines.insert(last + 2, "@on idle\n@end")
+    lines.insert(
+        lines.index(next(ln for ln in lines if ln.startswith("% retract_arm"))) + 1,
+        "% idle tactile_contact finger=ring threshold=5mm",
+    )
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / "pour_watched.dial"
+        path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+        script = load(path, loader=load_scene_names)
+        print("watched spans: pour.dial with a monitor armed through its whole block")
+        engine_overhead(script, repeat)
 
 
 def _fake_cost(text: str) -> tuple[float, int]:
@@ -282,6 +307,7 @@ def main() -> None:
     world, replay = engine_overhead(args.script, args.repeat)
     if _is_pour(world):
         pour_physics(args.script, replay, args.repeat)
+        watched_overhead(args.repeat)
     scheduler_cost(args.runs)
 
 

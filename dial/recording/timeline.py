@@ -44,6 +44,8 @@ FIELDS: dict[str, dict[str, type | tuple[type, ...]]] = {
 def _checked(record: object, path: Path, n: int) -> dict[str, Any]:
     if not isinstance(record, dict) or not isinstance(record.get("kind"), str):
         raise DialError(f"{path}:{n}: not a dial log record (no 'kind')")
+    if n == 1 and record["kind"] != "scene":
+        raise DialError(f"{path}: not a dial run log (it must start with a 'scene' record)")
     for key, kind in FIELDS.get(record["kind"], {}).items():
         value = record.get(key)
         if not isinstance(value, kind) or (kind is int and isinstance(value, bool)):
