@@ -24,13 +24,15 @@ from dial.disturb import Disturbance, parse_disturbance
 from dial.errors import DialError, OptionError
 from dial.instructions.scene_names import SceneNotFoundError
 from dial.parser.check import load as parse_and_check
-from dial.parser.script import Script
+from dial.parser.script import Script, Step, TBlock, TCall, TIf, TRepeat
 from dial.resources import resolve_script
 from dial.scene import load_scene_names
 from dial.scene.resolve import scene_option
 
-if TYPE_CHECKING:  # MuJoCo is imported only to run: `import dial` and checking stay light
+if TYPE_CHECKING:  # trio and MuJoCo load only to run: `import dial` and checking stay light
+    from dial.debug import Break, Console
     from dial.engine import Observer, RunResult
+    from dial.engine.state import Saved
 
 Progress = Callable[[int, float, list[str]], None]
 
@@ -73,8 +75,16 @@ def writable(path: str | Path, what: str) -> Path:
         why = f"'{path}' is a directory"
     elif not folder.is_dir():
         why = f"no such directory '{folder}'"
-    elif not os.access(folder, os.W_OK) or (target.exists() and not os.access(target, os.W_OK)):
-        why = f"permission denied: '{path}'"
+    else:  # try it: permissions, read-only file systems and /proc say no only to a write
+        existed = target.exists()
+        try:
+            with open(target, "a", encoding="utf-8"):
+                pass
+        except OSError as e:
+            why = f"{e.strerror or e}: '{path}'"
+        else:
+            if not existed:
+                target.unlink()
     if why is not None:
         raise DialError(f"cannot write {what}: {why}")
     return target
@@ -114,36 +124,26 @@ def run(
     realtime: bool = False,
     observers: Sequence[Observer] = (),
     progress: Progress | None = None,
+    breaks: Sequence[str] = (),
+    step: bool = False,
+    save_at: tuple[int, str | Path] | None = None,
+    resume: str | Path | None = None,
+    console: Console | None = None,
 ) -> RunResult:
     """Run a script in its scene, as ``dial run`` does, and return its :class:`RunResult`.
 
-    ``script``: a checked :class:`Script` (from :func:`load`), or a path or bundled name to
-    load. ``tick`` (s) overrides ``@tick``, and ``speed`` divides it; ``perturb`` (mm) moves
-    the objects away from their believed poses in a direction drawn from ``seed``;
-    ``disturb``: ``--disturb`` SPECs (DESIGN 2.8). ``log``: a JSON Lines file (path or open
-    text file), flushed record by record; ``log_states`` adds the robot's state 25 times per
-    simulated second. ``record`` (.rrd), ``video`` (.mp4/.gif), ``rerun`` and ``viewer``
-    watch the run; ``observers`` are your own (:class:`~dial.engine.Observer`). ``progress``
-    is called after every tick with (tick, simulated s, running events).
-
-    A stop signal (SIGINT, SIGTERM) ends the run cleanly: ``result.summary.interrupted``.
+    ``script``: a :class:`Script` from :func:`load`, or a path or bundled name to load (with
+    ``scene``). The keywords are ``dial run``'s options, each described in docs/api.md. A
+    stop signal (SIGINT, SIGTERM) ends the run cleanly: ``result.summary.interrupted``.
     """
-    check_options(tick, speed, seed, perturb)
-    try:
-        items = [d if not isinstance(d, str) else parse_disturbance(d) for d in disturb]
-    except DialError as e:
-        raise OptionError(str(e)) from None
+    items, saved = _checked(tick, speed, seed, perturb, disturb, save_at, resume)
     _check_watching(record, video, rerun, viewer)  # before the script: usage comes first
-    if isinstance(script, Script):
-        if scene is not None:
-            raise OptionError("scene= applies when loading: pass it to dial.load()")
-    else:
-        script = load(script, scene=scene)
+    script = _script(script, scene)
     from dial.engine import RunOptions
     from dial.engine import run as run_engine
 
+    stops, console = _pausing(script, breaks, step, console)
     with _log_sink(log) as sink:
-        watchers = _watchers(record, video, rerun, viewer, Path(script.path).name)
         options = RunOptions(
             tick=tick,
             speed=speed,
@@ -154,9 +154,88 @@ def run(
             log=sink,
             log_states=log_states,
             progress=progress,
-            observers=[*watchers, *observers],
+            observers=[*_watchers(record, video, rerun, viewer, script), *observers],
+            breaks=stops,
+            step=step,
+            console=console,
+            save_at=None if save_at is None else (save_at[0], Path(save_at[1])),
+            resume=saved,
         )
         return run_engine(script, options)
+
+
+def _checked(
+    tick: float | None,
+    speed: float,
+    seed: int,
+    perturb: float,
+    disturb: Sequence[str | Disturbance],
+    save_at: tuple[int, str | Path] | None,
+    resume: str | Path | None,
+) -> tuple[list[Disturbance], Saved | None]:
+    """The option checks that need no script: ranges, SPECs, the state files."""
+    check_options(tick, speed, seed, perturb)
+    if resume is not None and (tick is not None or speed != 1.0 or seed or perturb or disturb):
+        raise OptionError(
+            "--resume takes the tick, seed, perturbation and disturbances from the state "
+            "file: give none of --tick, --speed, --seed, --perturb, --disturb with it"
+        )
+    try:
+        items = [d if not isinstance(d, str) else parse_disturbance(d) for d in disturb]
+    except DialError as e:
+        raise OptionError(str(e)) from None
+    if save_at is not None:
+        if save_at[0] < 1:
+            raise OptionError(f"--save-at block:N needs N >= 1, got {save_at[0]}")
+        writable(save_at[1], "the state file")
+    return items, None if resume is None else _load_state(Path(resume))
+
+
+def _script(script: Script | str | Path, scene: str | None) -> Script:
+    if not isinstance(script, Script):
+        return load(script, scene=scene)
+    if scene is not None:
+        raise OptionError("scene= applies when loading: pass it to dial.load()")
+    return script
+
+
+def _pausing(
+    script: Script, breaks: Sequence[str], step: bool, console: Console | None
+) -> tuple[list[Break], Console | None]:
+    """The breakpoints, and where a paused run reads commands (a terminal, else stdin)."""
+    from dial.debug import LineConsole, TerminalConsole, parse_break
+
+    stops = [parse_break(b, _event_names(script)) for b in breaks]
+    if (stops or step) and console is None:
+        console = TerminalConsole() if sys.stdin.isatty() else LineConsole()
+    return stops, console
+
+
+def _event_names(script: Script) -> set[str]:
+    """The events of a script and of every script it calls (``--break EVENT``)."""
+    names, todo, seen = set(), [script], set()
+    while todo:
+        current = todo.pop()
+        if current.path in seen:
+            continue
+        seen.add(current.path)
+        names |= set(current.events)
+        todo += list(_callees(current.timeline))
+    return names
+
+
+def _callees(steps: tuple[Step, ...]) -> Iterator[Script]:
+    for step in steps:
+        if isinstance(step, TCall):
+            yield step.script
+        elif isinstance(step, TBlock):
+            for on in step.reactions:
+                yield from _callees(on.body)
+        elif isinstance(step, TRepeat):
+            yield from _callees(step.body)
+        elif isinstance(step, TIf):
+            yield from _callees(step.then)
+            yield from _callees(step.orelse)
 
 
 def _check_watching(
@@ -184,16 +263,18 @@ def _check_watching(
 
 
 def _watchers(
-    record: str | Path | None, video: str | Path | None, rerun: bool, viewer: bool, title: str
+    record: str | Path | None, video: str | Path | None, rerun: bool, viewer: bool, script: Script
 ) -> list[Observer]:
     """The observers behind ``record``, ``video``, ``rerun`` and ``viewer`` (checked)."""
     watchers: list[Observer] = []
     if record is not None or rerun:
+        from dial.parser.lanes import LanePlan
         from dial.recording.observers import Recorder
         from dial.recording.rerun_sink import RerunSink
 
         path = None if record is None else Path(record)
-        watchers.append(Recorder(RerunSink(path, spawn=rerun), title))
+        sink = RerunSink(path, spawn=rerun)  # the lanes in script order:
+        watchers.append(Recorder(sink, Path(script.path).name, plan=LanePlan.from_script(script)))
     if video is not None:
         from dial.recording.video import VideoWriter
 
@@ -203,3 +284,9 @@ def _watchers(
 
         watchers.append(PassiveViewer())
     return watchers
+
+
+def _load_state(path: Path) -> Saved:
+    from dial.engine.state import load as load_state  # MuJoCo loads only to run
+
+    return load_state(path)

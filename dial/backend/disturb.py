@@ -11,12 +11,11 @@ differentials read 0 (no load), joint angles read their set-points (no position 
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import mujoco
 import numpy as np
 
-from dial.backend.guards import Readings
 from dial.backend.snapshot import FloatArray
 from dial.disturb import Disturbance, DisturbanceError, Dropout, Push
 from dial.scheduler.types import Happening
@@ -43,7 +42,7 @@ class Disturbances:
         self.windows = windows
         self._boundaries = sorted({w.begin for w in windows} | {w.end for w in windows if w.end})
         self._active: list[_Window] = []
-        self.dropping = False  # a dropout is acting now
+        self.dropped: frozenset[tuple[str, int]] = frozenset()  # (sensor, finger) out now
 
     @classmethod
     def none(cls) -> Disturbances:
@@ -69,6 +68,19 @@ class Disturbances:
             windows.append(_Window(item, round(item.at / dt), end, body))
         return cls(tuple(windows))
 
+    def resume_at(self, step: int) -> None:
+        """Take up the disturbances acting at ``step`` (a run resumed from a state file; the
+        forces are in the saved physics already)."""
+        self._active = [
+            w for w in self.windows if w.begin < step and (w.end is None or step < w.end)
+        ]
+        self._set_dropped()
+
+    def _set_dropped(self) -> None:
+        self.dropped = frozenset(
+            (w.item.sensor, w.item.finger) for w in self._active if isinstance(w.item, Dropout)
+        )
+
     def due(self, step: int, substeps: int) -> bool:
         """Whether one begins or ends within the next ``substeps`` physics steps."""
         return any(step <= b < step + substeps for b in self._boundaries)
@@ -91,7 +103,7 @@ class Disturbances:
                 if w.body == body and isinstance(w.item, Push):
                     force += w.item.force
             data.xfrc_applied[body, :3] = force
-        self.dropping = any(isinstance(w.item, Dropout) for w in self._active)
+        self._set_dropped()
 
     def _dropouts(self) -> list[Dropout]:
         return [w.item for w in self._active if isinstance(w.item, Dropout)]
@@ -108,20 +120,6 @@ class Disturbances:
                 differentials[joints] = 0.0
             else:
                 q[joints] = target[joints]
-
-    def masked(self, readings: Readings) -> Readings:
-        """The guard readings of this physics step, with the dropouts applied."""
-        tactile = list(readings.tactile)
-        differentials, q = readings.differentials.copy(), np.array(readings.q, dtype=np.float64)
-        for d in self._dropouts():
-            joints = slice(4 * d.finger, 4 * d.finger + 4)
-            if d.sensor == "tactile":
-                tactile[d.finger] = np.zeros_like(tactile[d.finger])
-            elif d.sensor == "force":
-                differentials[joints] = 0.0
-            else:
-                q[joints] = readings.target[joints]
-        return replace(readings, tactile=tactile, differentials=differentials, q=q)
 
 
 def _record(w: _Window, phase: str, t: float, step: int) -> Happening:

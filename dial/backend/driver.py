@@ -40,7 +40,8 @@ class MujocoRobot:
     ) -> None:
         self.model, self.data = model, data
         self.index = ix = RobotIndex.from_model(model)
-        self.substeps = max(1, round(period / model.opt.timestep))
+        self._dt = float(model.opt.timestep)  # looked up once: model.opt is slow to reach
+        self.substeps = max(1, round(period / self._dt))
         self._period = self.substeps * model.opt.timestep
         self.steps = 0
         self.arm_target = data.qpos[ix.arm_qpos].copy()
@@ -57,6 +58,7 @@ class MujocoRobot:
         # The four arrays' sensordata, in one fancy index: one copy per snapshot, not four.
         self._tactile_idx = np.concatenate([np.arange(a, a + 256) for a in self._tactile_adr])
         self.safety = Safety(model, data, ix)
+        self._readings = Readings(data, ix, self._tactile_adr)
         hand_joints = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, n) for n in HAND_JOINTS]
         self.hand_range = model.jnt_range[hand_joints].copy()  # (16, 2) rad, mask order
         self.hand_range.flags.writeable = False
@@ -71,14 +73,14 @@ class MujocoRobot:
     @property
     def time(self) -> float:
         """Simulated s since the first tick."""
-        return self.steps * float(self.model.opt.timestep)
+        return self.steps * self._dt
 
     def snapshot(self) -> Snapshot:
         d, ix = self.data, self.index
         tactile = d.sensordata[self._tactile_idx].reshape(4, 16, 16)
         differentials = tendon_differentials(d, ix)
         hand_q = d.qpos[ix.hand_qpos]
-        if self.disturbances.dropping:  # fresh copies above: mask them in place
+        if self.disturbances.dropped:  # fresh copies above: mask them in place
             self.disturbances.mask(tactile.reshape(4, 256), differentials, hand_q, self.hand_target)
         # Fancy-indexed arrays are fresh copies: freeze them in place; copy only views.
         return Snapshot(
@@ -95,22 +97,21 @@ class MujocoRobot:
             tool_rot=frozen(d.site_xmat[ix.tool_site].reshape(3, 3)),
             tips=frozen(d.site_xpos[ix.fingertip_sites], fresh=True),
             trips=dict(self._trips),
+            dropped=self.disturbances.dropped,
         )
 
     def advance(self) -> Report | None:
         """Apply the slots and step one control period; report what happened, if anything."""
         self._apply()
         m, d = self.model, self.data
-        if (
-            not self.guards
-            and not self.threads
-            and not self.disturbances.due(self.steps, self.substeps)
-        ):
+        due = self.disturbances.due(self.steps, self.substeps)
+        if not self.guards and not self.threads and not due:
             mujoco.mj_step(m, d, nstep=self.substeps)
             self.steps += self.substeps
         else:
             for _ in range(self.substeps):
-                self.disturbances.apply(self.steps, d, self._happened, self.time)
+                if due:
+                    self.disturbances.apply(self.steps, d, self._happened, self.time)
                 mujoco.mj_step(m, d)
                 self.steps += 1
                 for thread in self.threads:
@@ -195,21 +196,9 @@ class MujocoRobot:
         target = np.where(self.limp, d.qpos[ix.hand_qpos], self.hand_target)
         d.ctrl[ix.tendon_actuators] = hand_ctrl(target)
 
-    def _readings(self) -> Readings:
-        d, ix = self.data, self.index
-        sd = d.sensordata
-        readings = Readings(
-            [sd[a : a + 256] for a in self._tactile_adr],
-            tendon_differentials(d, ix),
-            self.hand_target,
-            d.qpos[ix.hand_qpos],
-        )
-        if self.disturbances.dropping:
-            readings = self.disturbances.masked(readings)
-        return readings
-
     def _check_guards(self) -> None:
-        for key, guard, trip in self.guards.check(self._readings(), self.time, self.steps):
+        readings = self._readings.at_step(self.hand_target, self.disturbances.dropped)
+        for key, guard, trip in self.guards.check(readings, self.steps * self._dt, self.steps):
             if guard.effector is None:  # a monitor: the runner preempts the block
                 self._fired.append(Fired(key, trip.time, trip.step))
                 self.monitors.discard(key)

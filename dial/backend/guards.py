@@ -12,7 +12,11 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from dial.backend.contact import contact_reading
+import mujoco
+import numpy as np
+
+from dial.backend.contact import POSITION_LEVER
+from dial.backend.model import RobotIndex, tendon_differentials
 from dial.backend.snapshot import FloatArray, Trip
 
 
@@ -28,18 +32,42 @@ class Guard:
     negated: bool = False
 
 
-@dataclass(frozen=True)
 class Readings:
-    """What the contact conditions read at one physics step (sensor dropouts applied).
+    """What guards and monitors read at one physics step, computed only as far as they need
+    (this runs after every physics step while one is armed). The formulas are
+    :func:`~dial.backend.contact.contact_reading`'s; a dropped-out sensor reads 0. One per
+    robot: :meth:`at_step` starts each step afresh."""
 
-    ``tactile``: four (256,) taxel depth arrays in m, finger order; ``differentials`` (16,)
-    N; ``target`` and ``q`` (16,) joint set-points and angles in rad, mask order.
-    """
+    __slots__ = ("_data", "_diff", "_dropped", "_index", "_q", "_tactile", "_target")
 
-    tactile: Sequence[FloatArray]
-    differentials: FloatArray
-    target: FloatArray
-    q: FloatArray
+    def __init__(self, data: mujoco.MjData, index: RobotIndex, tactile_adr: Sequence[int]) -> None:
+        self._data, self._index = data, index
+        # Views into sensordata stay valid for the data's life: slicing once saves a lot.
+        self._tactile = [data.sensordata[a : a + 256] for a in tactile_adr]
+        self._target: FloatArray = np.zeros(16)
+        self._dropped: frozenset[tuple[str, int]] = frozenset()
+        self._diff: FloatArray | None = None
+        self._q: FloatArray | None = None
+
+    def at_step(self, target: FloatArray, dropped: frozenset[tuple[str, int]]) -> Readings:
+        self._target, self._dropped = target, dropped
+        self._diff = self._q = None
+        return self
+
+    def value(self, kind: str, f: int, baseline: FloatArray) -> float:
+        """The reading of contact ``kind`` on finger ``f``: m (tactile, position) or N."""
+        if self._dropped and (kind, f) in self._dropped:
+            return 0.0
+        if kind == "tactile":
+            return float(self._tactile[f].max())
+        joints = slice(4 * f, 4 * f + 4)
+        if kind == "force":
+            if self._diff is None:
+                self._diff = tendon_differentials(self._data, self._index)
+            return float(np.abs(self._diff[joints] - baseline[joints]).max())
+        if self._q is None:
+            self._q = self._data.qpos[self._index.hand_qpos]
+        return float(np.linalg.norm(self._target[joints] - self._q[joints])) * POSITION_LEVER
 
 
 def first_trip(guard: Guard, r: Readings, time: float, step: int) -> Trip | None:
@@ -52,9 +80,7 @@ def first_trip(guard: Guard, r: Readings, time: float, step: int) -> Trip | None
     first: tuple[str, int, float] | None = None
     for kind, threshold in guard.conditions:
         for f in guard.sense:
-            value = contact_reading(
-                kind, f, r.tactile[f], r.differentials, r.target, r.q, guard.baseline
-            )
+            value = r.value(kind, f, guard.baseline)
             if value >= threshold:
                 return None if guard.negated else Trip(time, step, kind, f, value)
             if first is None:
@@ -87,7 +113,7 @@ class Guards:
 
     def check(self, readings: Readings, time: float, step: int) -> list[tuple[int, Guard, Trip]]:
         """The guards that trip at this step (each is disarmed: it fires once)."""
-        tripped = []
+        tripped: list[tuple[int, Guard, Trip]] = []
         for key, guard in self.armed.items():
             trip = first_trip(guard, readings, time, step)
             if trip is not None:

@@ -45,6 +45,7 @@ class Snapshot:
     tool_rot: FloatArray
     tips: FloatArray
     trips: Mapping[int, Trip]
+    dropped: frozenset[tuple[str, int]] = frozenset()  # (sensor, finger) read as untouched
 
 
 def frozen(array: NDArray[np.float64], fresh: bool = False) -> FloatArray:

@@ -30,7 +30,10 @@ class Get:
 
 
 def contact_value(kind: str, snapshot: Snapshot, finger: int, baseline: FloatArray | None) -> float:
-    """The reading a contact condition compares with its threshold (m or N)."""
+    """The reading a contact condition compares with its threshold (m or N); a dropped-out
+    sensor reads 0, as the driver's guards read it."""
+    if (kind, finger) in snapshot.dropped:
+        return 0.0
     return contact_reading(
         kind,
         finger,

@@ -67,6 +67,10 @@ class Records:
             record["preempted"] = True
         self.log.append(record)
 
+    def block(self, path: str, number: int, line: int, tick: int, t: float) -> None:
+        """The ``number``-th block the run starts (``--save-at block:N`` counts the same)."""
+        self.log.write("block", number=number, line=line, tick=tick, t=t, **self._whose(path))
+
     def condition(self, path: str, cond: Condition, value: bool, tick: int, t: float) -> None:
         self.log.write(
             "condition", condition=str(cond), value=value, tick=tick, t=t, **self._whose(path)
@@ -90,8 +94,8 @@ class Records:
             **self._whose(path),
         )
 
-    def happening(self, happening: Happening) -> None:
-        self.log.write(happening.kind, **happening.fields)
+    def happening(self, happening: Happening, tick: int) -> None:
+        self.log.write(happening.kind, **happening.fields, tick=tick)
 
     def error(self, event: str | None, tick: int, t: float, message: str) -> None:
         self.log.write("error", event=event, tick=tick, t=t, message=message)
