@@ -65,7 +65,7 @@ def test_load_scene_names_reports_masks_locations_programs() -> None:
     assert names.name == "lightbulb"
     assert names.poses["prelight"] == 0xFFFF
     assert names.poses["unscrew"] == 0x1010  # middle and thumb abduction: the grip is kept
-    assert names.poses["ungrasp"] == 0xEEEE
+    assert names.poses["ungrasp"] == 0xEEEF  # flexion, and the index abducts with the middle
     assert names.poses["point_down"] == 0x000F
     assert "above_bulb" in names.locations
     assert names.programs == PAPER_PROGRAMS["lightbulb"]
