@@ -215,14 +215,14 @@ class _Checker:
         if event.effectors or not instr.sensing:
             what = ", ".join(e for e in EFFECTORS if e in event.effectors) or "an effector"
             self.error(
-                line.watches[0].span,
+                line.span_of(*line.watches[0]),
                 f"event '{line.event}' cannot be watched: '~' marks a sensing event, and "
                 f"'{line.event}' ({instr.name}) commands {what}",
             )
             return False
         if instr.name not in WATCHABLE:
             self.error(
-                line.watches[0].span,
+                line.span_of(*line.watches[0]),
                 f"event '{line.event}' ({instr.name}) cannot be watched: only "
                 f"{', '.join(WATCHABLE[:-1])} and {WATCHABLE[-1]} can, because only a contact "
                 "condition holds or not at each moment",

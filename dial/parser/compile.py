@@ -116,11 +116,12 @@ def compile_block(block: Block, checks: Checks) -> TBlock:
         if event is None:
             continue
         if line.watches and checks.watched(line):
-            watches += (Watch(line.event, line.line, w.start, w.end, w.span) for w in line.watches)
+            watches += (
+                Watch(line.event, line.line, w.start, w.end, line.span_of(w.start, w.end))
+                for w in line.watches
+            )
         name, number, effectors = line.event, line.line, event.effectors
-        runs += [
-            Run(name, number, m.start, m.exec_end, m.hold_end, effectors, m.span) for m in line.runs
-        ]
+        runs += [Run(name, number, s, e, h, effectors, line.span_of(s, h)) for s, e, h in line.runs]
     runs.sort(key=_START_LINE)
     conflicts(runs, checks)
     watches.sort(key=_START_LINE)

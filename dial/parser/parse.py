@@ -10,7 +10,7 @@ from difflib import get_close_matches
 from functools import lru_cache
 from typing import NamedTuple
 
-from dial.errors import Diagnostic, ScriptError, Span
+from dial.errors import Diagnostic, ScriptError, Span, shorten
 from dial.parser import directives as args
 from dial.parser.ast import (
     Block,
@@ -27,7 +27,7 @@ from dial.parser.ast import (
 from dial.parser.diagram import Diagram, read_diagram
 from dial.parser.source import Kind, Line, scan
 from dial.parser.structure import Structure
-from dial.parser.words import WordError, tokenize
+from dial.parser.words import WordError, bare_words, tokenize
 from dial.units import UnitError, parse_quantity
 
 NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
@@ -230,21 +230,10 @@ class _Parser:
 
     @staticmethod
     def exec_line(p: _PendingLine, base: int) -> ExecLine:
-        number = p.number
         shift = 1 - base
-        runs = tuple(
-            [
-                RunMark(s + shift, e + shift, h + shift, Span(number, s + 1, h + 2))
-                for s, e, h in p.marks.runs
-            ]
-        )
-        watches = tuple(
-            [
-                WatchMark(s + shift, e + shift, Span(number, s + 1, e + 2))
-                for s, e in p.marks.watches
-            ]
-        )
-        return ExecLine(p.event, runs, p.last_col - base + 1, number, watches)
+        runs = tuple([RunMark(s + shift, e + shift, h + shift) for s, e, h in p.marks.runs])
+        watches = tuple([WatchMark(s + shift, e + shift) for s, e in p.marks.watches])
+        return ExecLine(p.event, runs, p.last_col + shift, p.number, watches, base + 1)
 
     # -- directives -----------------------------------------------------------------------
     def directive(self, ln: Line) -> None:
@@ -259,22 +248,11 @@ class _Parser:
             valid = ", ".join("@" + d for d in DIRECTIVES)
             self.error(
                 Span(ln.number, 1, max(end, 2) + 1),
-                f"unknown directive '{code.split()[0]}'{hint} (valid: {valid})",
+                f"unknown directive '{shorten(code.split()[0])}'{hint} (valid: {valid})",
             )
             return
-        params: list[Param] | None = None
-        words: list[Word] | None = None
-        try:
-            params = tokenize(ln.number, code, end)
-            keyed = next((p for p in params if p.key is not None), None)
-            if keyed is not None:
-                self.error(keyed.span, f"unexpected '{keyed.key}=' in '@{name}'")
-                params = None
-            else:
-                words = [w for p in params for w in p.words]
-        except WordError as e:
-            if not e.known:
-                self.error(e.span, e.message)
+        read = self.arguments(ln.number, code, end, name)
+        params, words = read if read is not None else (None, None)
         # Block structure is kept even when the arguments are bad, so that one
         # mistake does not also unbalance every '@end' after it.
         if name in ("repeat", "if", "on"):
@@ -302,7 +280,27 @@ class _Parser:
                 level = self.structure.level
                 self.structure.add(Call(words[0].text, ln.number, words[0].span, level), span)
         elif name in ("resume", "retry", "abort"):
-            self.structure.ending(name, span, params, ln.number)
+            self.structure.ending(name, span, params, words, ln.number)
+
+    def arguments(
+        self, number: int, code: str, end: int, name: str
+    ) -> tuple[list[Param], list[Word]] | None:
+        """A directive's parameters and their words, or None if they are malformed."""
+        words = bare_words(number, code, end)
+        if words is not None:  # no quotes, no key=value: as most directives are
+            params = [Param(None, (w,), False, w.span) for w in words] if name == "abort" else []
+            return params, words
+        try:
+            params = tokenize(number, code, end)
+        except WordError as e:
+            if not e.known:
+                self.error(e.span, e.message)
+            return None
+        keyed = next((p for p in params if p.key is not None), None)
+        if keyed is not None:
+            self.error(keyed.span, f"unexpected '{keyed.key}=' in '@{name}'")
+            return None
+        return params, [w for p in params for w in p.words]
 
     def _top_level(self, span: Span, name: str) -> bool:
         if self.structure.nested:

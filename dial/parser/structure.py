@@ -108,7 +108,7 @@ class Structure:
                 for ln in stmt.lines if stmt.line not in self.lenient else ():
                     for w in ln.watches if ln.event not in handled else ():
                         self.error(
-                            w.span,
+                            ln.span_of(*w),
                             f"event '{ln.event}' is watched here, but no '@on {ln.event}' or "
                             f"'@on !{ln.event}' follows the block: add one, or remove the '~'",
                         )
@@ -185,9 +185,10 @@ class Structure:
             self.lenient.add(block.line)
         return cond
 
-    def ending(self, name: str, span: Span, params: list[Param], number: int) -> None:
+    def ending(
+        self, name: str, span: Span, params: list[Param], words: list[Word], number: int
+    ) -> None:
         """``@resume``, ``@retry [max N]``, ``@abort "MESSAGE"``."""
-        words = [w for p in params for w in p.words]
         stmt: Ending | None = None
         if name == "resume":
             if args.arity(self.error, span, name, words, 0, "no arguments"):
