@@ -85,6 +85,12 @@ def test_counted_repeats_are_never_unrolled() -> None:
     assert "@repeat 1000 (drawn once of 1000)" in shown
 
 
+def test_a_million_repeats_show_compactly() -> None:
+    script = check_text(GO + "@repeat 1000000\ngo #\n@end\n", "x.dial")
+    shown = render(script)
+    assert shown.splitlines()[0].endswith(", 1000000 ticks") and len(shown) < 2000
+
+
 def test_a_small_timeline_is_still_expanded() -> None:
     layout = expand(check_text(GO + "@repeat 3\ngo #\n@end\n", "x.dial"))
     assert not layout.compact and layout.length == 3 == layout.expanded

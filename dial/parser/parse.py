@@ -53,8 +53,12 @@ class _Problem(NamedTuple):
     message: str
 
 
-@lru_cache(maxsize=4096)
 def _read_execution(code: str) -> tuple[str, int, int, Diagram] | _Problem:
+    # Long lines are rare and costly to keep: only short ones are cached.
+    return _read_short(code) if len(code) <= 400 else _read_line(code)
+
+
+def _read_line(code: str) -> tuple[str, int, int, Diagram] | _Problem:
     """An execution line (comments blanked, right-stripped): its event, the first and last
     diagram columns and the marks; or its first problem.
 
@@ -84,6 +88,9 @@ def _read_execution(code: str) -> tuple[str, int, int, Diagram] | _Problem:
     if not isinstance(marks, Diagram):
         return _Problem(marks[0] + 1, marks[0] + 2, marks[1])
     return event, first, len(code) - 1, marks
+
+
+_read_short = lru_cache(maxsize=4096)(_read_line)
 
 
 class _Parser:
@@ -116,7 +123,7 @@ class _Parser:
                 continue
             if kind is comment:
                 continue
-            if self.block:
+            if self.block or not self.block_ok:
                 self.flush()
             if kind is Kind.DEFINITION:
                 self.definition(ln)
@@ -218,10 +225,10 @@ class _Parser:
     def flush(self) -> None:
         pending, ok = self.block, self.block_ok
         self.block, self.block_ok = [], True
-        if not pending:
-            return
         if not ok:
             self.structure.drop_block()
+            return
+        if not pending:
             return
         base = min([p.first_col for p in pending])
         lines = tuple([self.exec_line(p, base) for p in pending])

@@ -46,6 +46,15 @@ class _Frame:
     condition: Condition | None = None  # of '@if'; of '@on' only when it attaches to a block
     line: int = 0
     too_deep: bool = False  # beyond MAX_NESTING: reported, and dropped with what it holds
+    # Per statement list (False: ``statements``, True: ``then``), how long it was when a
+    # block with errors was left out of it: an '@on' right after that block is not also
+    # reported as following no block.
+    dropped: dict[bool, int] = field(default_factory=dict)
+
+    @property
+    def in_then(self) -> bool:
+        return self.kind == "if" and not self.in_else
+
     lost: bool = False  # a nested directive of it was dropped (its problem is reported)
 
 
@@ -56,9 +65,6 @@ class Structure:
         self.error = error
         self.base = depth  # the nesting level of the '@call' that runs this script
         self.stack: list[_Frame] = [_Frame("top", Span(1, 1, 2))]
-        # The statement list a broken block was dropped from, and its length then: an '@on'
-        # right after it is not also reported as following no block.
-        self.dropped: tuple[list[Statement], int] | None = None
         self.lenient: set[int] = set()  # blocks whose '@on' headers were broken
 
     @property
@@ -67,7 +73,7 @@ class Structure:
 
     def statements(self) -> list[Statement]:
         frame = self.stack[-1]
-        return frame.statements if frame.kind != "if" or frame.in_else else frame.then
+        return frame.then if frame.in_then else frame.statements
 
     def add(self, stmt: Statement, span: Span) -> None:
         """Append ``stmt`` (which starts at ``span``) to the current list, if reachable."""
@@ -76,7 +82,8 @@ class Structure:
 
     def drop_block(self) -> None:
         """A block with errors is left out; remember where, for a following ``@on``."""
-        self.dropped = (self.statements(), len(self.statements()))
+        frame = self.stack[-1]
+        frame.dropped[frame.in_then] = len(self.statements())
 
     def reachable(self, span: Span) -> bool:
         """False, reported, if a reaction ending precedes ``span`` in its statement list."""
@@ -164,8 +171,8 @@ class Structure:
         stmts = self.statements()
         block = stmts[-1] if stmts and isinstance(stmts[-1], Block) else None
         if block is None:
-            dropped = self.dropped
-            if dropped is None or dropped[0] is not stmts or dropped[1] != len(stmts):
+            frame = self.stack[-1]
+            if frame.dropped.get(frame.in_then) != len(stmts):
                 self.error(span, "'@on' must come directly after the block it watches")
             return None
         if cond is not None and cond.event not in block.watched:
