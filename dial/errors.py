@@ -11,6 +11,11 @@ class DialError(Exception):
     """Root of every error the package raises on purpose."""
 
 
+class OptionError(DialError):
+    """An option (of ``dial run``, or of :func:`dial.run`) out of its range or unusable:
+    a usage error, exit status 2. The message names the option and what was expected."""
+
+
 class Span(NamedTuple):
     """A place in a source file: 1-based line and column, ``end_col`` exclusive.
 

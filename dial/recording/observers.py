@@ -1,4 +1,4 @@
-"""Observers of a run (see :class:`dial.engine.Observer`): the rerun recorder and the state log.
+"""The rerun recorder, an observer of a run (see :class:`dial.engine.Observer`).
 
 They sample on whole numbers of control periods, so a frame's time is exact simulated time
 and the same run gives the same frames.
@@ -7,18 +7,11 @@ and the same run gives the same frames.
 from __future__ import annotations
 
 import mujoco
-import numpy as np
 
-from dial.backend.driver import MujocoRobot
 from dial.engine import RunResult, Watched
 from dial.recording.frames import RECORD_HZ, Frames, every
 from dial.recording.geometry import task_camera
 from dial.recording.rerun_sink import RerunSink
-from dial.scheduler.log import EventLog
-
-STATE_HZ = 25.0  # state records per second of simulated time (--log-states)
-STATE_DIGITS = 4  # 0.1 mm and 0.1 mrad: plenty to draw, and a third shorter than the default
-TENSION_DIGITS = 2  # 0.01 N
 
 
 def object_bodies(model: mujoco.MjModel, bodies: list[str]) -> list[int]:
@@ -68,50 +61,6 @@ class Recorder:
             self.sink.frames(batch)
 
     def end(self, result: RunResult | None) -> None:
-        self._drain()
+        self._drain()  # the log's last record is the engine's summary
         self._send()
-        if result is not None:
-            summary = {
-                "kind": "summary",
-                "ok": result.ok,
-                "success": result.success,
-                "criteria": result.details,
-                "sim_time": result.summary.sim_time,
-            }
-            self.sink.record(summary, self._tick, None)
         self.sink.close()
-
-
-class StateLog:
-    """Writes ``state`` records into the log at ``rate_hz`` (``--log-states``), for replay.
-
-    The one observer that writes: it adds records to the log, and only when asked.
-    A record holds ``t``, ``tick``, the whole ``qpos`` (the arm, the hand, and every free
-    object) and the 32 tendon ``tension``s, which cannot be recomputed from positions.
-    """
-
-    def __init__(self, rate_hz: float = STATE_HZ) -> None:
-        self.rate_hz = rate_hz
-
-    def begin(self, run: Watched) -> None:
-        self.robot: MujocoRobot = run.robot
-        self.log: EventLog = run.log
-        self.every = every(self.rate_hz, run.robot.period)
-        self._write(0, 0)
-
-    def period(self, periods: int, tick: int) -> None:
-        if periods % self.every == 0:
-            self._write(periods, tick)
-
-    def _write(self, periods: int, tick: int) -> None:
-        d, ix = self.robot.data, self.robot.index
-        self.log.write(
-            "state",
-            tick=tick,
-            t=periods * self.robot.period,
-            qpos=np.round(d.qpos, STATE_DIGITS),
-            tension=np.round(d.sensordata[ix.tension_sensors], TENSION_DIGITS),
-        )
-
-    def end(self, result: RunResult | None) -> None:
-        """Nothing to close: the log belongs to the run."""

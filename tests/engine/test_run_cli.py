@@ -83,6 +83,7 @@ def test_sigint_ends_the_run_with_130_and_a_complete_log(tmp_path: Path) -> None
     assert proc.wait(timeout=30) == 130
     assert time.monotonic() - sent < 10  # generous: the machine is shared
     records = [json.loads(line) for line in log.read_text().splitlines()]  # all complete
-    assert records[-1]["kind"] == "interrupted"
+    assert [r["kind"] for r in records[-2:]] == ["interrupted", "summary"]
+    assert records[-2]["signal"] == "SIGINT" and records[-1]["interrupted"] == "SIGINT"
     ticks = [r for r in records if r["kind"] == "tick"]
-    assert records[-1]["t"] <= ticks[-1]["t1"] + 0.5  # stopped within the tick it was in
+    assert records[-2]["t"] <= ticks[-1]["t1"] + 0.5  # stopped within the tick it was in

@@ -9,7 +9,7 @@ import pytest
 from rerun.chunk import RrdReader
 
 from dial.cli import main
-from dial.recording.observers import STATE_HZ
+from dial.engine.observe import STATE_HZ
 from dial.recording.timeline import describe, timeline, when
 from tests.recording.conftest import without_wall_time
 

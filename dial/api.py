@@ -1,0 +1,205 @@
+"""The Python API: load a script, run it as ``dial run`` does, read the result.
+
+    import dial
+
+    script = dial.load("pour.dial")           # a path, or a bundled example by name
+    result = dial.run(script, tick=0.2, perturb=10, seed=3, log="pour.jsonl")
+    result.ok, result.success, result.summary.sim_time
+
+Every option of :func:`run` is an option of ``dial run`` (see docs/api.md); the command
+line is a thin layer over these two functions.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import sys
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager, suppress
+from pathlib import Path
+from typing import TYPE_CHECKING, TextIO
+
+from dial.disturb import Disturbance, parse_disturbance
+from dial.errors import DialError, OptionError
+from dial.instructions.scene_names import SceneNotFoundError
+from dial.parser.check import load as parse_and_check
+from dial.parser.script import Script
+from dial.resources import resolve_script
+from dial.scene import load_scene_names
+from dial.scene.resolve import scene_option
+
+if TYPE_CHECKING:  # MuJoCo is imported only to run: `import dial` and checking stay light
+    from dial.engine import Observer, RunResult
+
+Progress = Callable[[int, float, list[str]], None]
+
+
+def load(path: str | Path, *, scene: str | None = None) -> Script:
+    """Parse and check a script: a path if it exists, else a bundled example by name.
+
+    ``scene`` (a world file or a bundled scene name) replaces the script's ``@scene``, and
+    that of every script it calls. Raises :class:`~dial.errors.ScriptError` listing every
+    problem, each as ``FILE:LINE:COL: message`` with a caret.
+    """
+    try:
+        override = None if scene is None else scene_option(scene)
+    except SceneNotFoundError as e:
+        raise OptionError(str(e)) from None
+    return parse_and_check(resolve_script(str(path)), loader=load_scene_names, scene=override)
+
+
+def check_options(
+    tick: float | None, speed: float, seed: int, perturb: float, jobs: int | None = None
+) -> None:
+    """Raise :class:`OptionError` for a value out of its range, naming the option."""
+    if tick is not None and not (math.isfinite(tick) and 0 < tick <= 60):
+        raise OptionError(f"--tick must be above 0 s and at most 60 s (as @tick), got {tick:g}")
+    if not (math.isfinite(speed) and speed > 0):
+        raise OptionError(f"--speed must be a positive number, got {speed:g}")
+    if seed < 0:
+        raise OptionError(f"--seed must be 0 or more, got {seed}")
+    if not (math.isfinite(perturb) and perturb >= 0):
+        raise OptionError(f"--perturb must be 0 mm or more, got {perturb:g}")
+
+
+def writable(path: str | Path, what: str) -> Path:
+    """``path`` if a file can be written there; else a one-line :class:`DialError` saying
+    why, before anything runs."""
+    target = Path(path)
+    folder = target.parent
+    why = None
+    if target.is_dir():
+        why = f"'{path}' is a directory"
+    elif not folder.is_dir():
+        why = f"no such directory '{folder}'"
+    elif not os.access(folder, os.W_OK) or (target.exists() and not os.access(target, os.W_OK)):
+        why = f"permission denied: '{path}'"
+    if why is not None:
+        raise DialError(f"cannot write {what}: {why}")
+    return target
+
+
+@contextmanager
+def _log_sink(log: str | Path | TextIO | None) -> Iterator[TextIO | None]:
+    if log is None or not isinstance(log, str | Path):
+        yield log
+        return
+    try:
+        sink = open(writable(log, "the log"), "w", encoding="utf-8")  # noqa: SIM115
+    except OSError as e:
+        raise DialError(f"cannot write the log: {e.strerror or e}: '{log}'") from None
+    try:
+        yield sink
+    finally:
+        with suppress(OSError):  # the run has reported a write error already
+            sink.close()
+
+
+def run(
+    script: Script | str | Path,
+    *,
+    scene: str | None = None,
+    tick: float | None = None,
+    speed: float = 1.0,
+    seed: int = 0,
+    perturb: float = 0.0,
+    disturb: Sequence[str | Disturbance] = (),
+    log: str | Path | TextIO | None = None,
+    log_states: bool = False,
+    record: str | Path | None = None,
+    video: str | Path | None = None,
+    rerun: bool = False,
+    viewer: bool = False,
+    realtime: bool = False,
+    observers: Sequence[Observer] = (),
+    progress: Progress | None = None,
+) -> RunResult:
+    """Run a script in its scene, as ``dial run`` does, and return its :class:`RunResult`.
+
+    ``script``: a checked :class:`Script` (from :func:`load`), or a path or bundled name to
+    load. ``tick`` (s) overrides ``@tick``, and ``speed`` divides it; ``perturb`` (mm) moves
+    the objects away from their believed poses in a direction drawn from ``seed``;
+    ``disturb``: ``--disturb`` SPECs (DESIGN 2.8). ``log``: a JSON Lines file (path or open
+    text file), flushed record by record; ``log_states`` adds the robot's state 25 times per
+    simulated second. ``record`` (.rrd), ``video`` (.mp4/.gif), ``rerun`` and ``viewer``
+    watch the run; ``observers`` are your own (:class:`~dial.engine.Observer`). ``progress``
+    is called after every tick with (tick, simulated s, running events).
+
+    A stop signal (SIGINT, SIGTERM) ends the run cleanly: ``result.summary.interrupted``.
+    """
+    check_options(tick, speed, seed, perturb)
+    try:
+        items = [d if not isinstance(d, str) else parse_disturbance(d) for d in disturb]
+    except DialError as e:
+        raise OptionError(str(e)) from None
+    _check_watching(record, video, rerun, viewer)  # before the script: usage comes first
+    if isinstance(script, Script):
+        if scene is not None:
+            raise OptionError("scene= applies when loading: pass it to dial.load()")
+    else:
+        script = load(script, scene=scene)
+    from dial.engine import RunOptions
+    from dial.engine import run as run_engine
+
+    with _log_sink(log) as sink:
+        watchers = _watchers(record, video, rerun, viewer, Path(script.path).name)
+        options = RunOptions(
+            tick=tick,
+            speed=speed,
+            seed=seed,
+            perturb_mm=perturb,
+            disturb=items,
+            realtime=realtime or viewer,
+            log=sink,
+            log_states=log_states,
+            progress=progress,
+            observers=[*watchers, *observers],
+        )
+        return run_engine(script, options)
+
+
+def _check_watching(
+    record: str | Path | None, video: str | Path | None, rerun: bool, viewer: bool
+) -> None:
+    """What can be known about ``record``, ``video``, ``rerun`` and ``viewer`` before a run."""
+    if record is not None and Path(record).suffix.lower() != ".rrd":
+        raise OptionError(f"--record writes a .rrd file, not '{record}'")
+    if video is not None:
+        if sys.platform.startswith("linux"):  # offscreen on the CPU; before MuJoCo loads
+            os.environ.setdefault("MUJOCO_GL", "egl")
+        from dial.recording.video import video_problem
+
+        problem = video_problem(str(video))
+        if problem is not None:
+            raise OptionError(problem)
+    if rerun or viewer:
+        from dial.recording.viewer import require_display
+
+        require_display("--rerun" if rerun else "--viewer")
+    if record is not None:
+        writable(record, "the recording")
+    if video is not None:
+        writable(video, "the video")
+
+
+def _watchers(
+    record: str | Path | None, video: str | Path | None, rerun: bool, viewer: bool, title: str
+) -> list[Observer]:
+    """The observers behind ``record``, ``video``, ``rerun`` and ``viewer`` (checked)."""
+    watchers: list[Observer] = []
+    if record is not None or rerun:
+        from dial.recording.observers import Recorder
+        from dial.recording.rerun_sink import RerunSink
+
+        path = None if record is None else Path(record)
+        watchers.append(Recorder(RerunSink(path, spawn=rerun), title))
+    if video is not None:
+        from dial.recording.video import VideoWriter
+
+        watchers.append(VideoWriter(Path(video)))
+    if viewer:
+        from dial.recording.viewer import PassiveViewer
+
+        watchers.append(PassiveViewer())
+    return watchers

@@ -1,0 +1,110 @@
+"""Run a checked script in its scene: set up, run the timeline, measure, summarise.
+
+This is the one place that joins the layers: the parser's script, the scheduler's runner,
+the primitives and the MuJoCo backend. The engine writes the ``scene``, ``state`` and
+``summary`` records; the runner writes the rest.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import TextIO
+
+import trio
+
+from dial.disturb import Disturbance
+from dial.engine.observe import Observer, StateLog, Watched, fan_out
+from dial.engine.result import RunResult, measure_criteria
+from dial.engine.setup import prepare
+from dial.errors import DialError
+from dial.parser.script import Script
+from dial.primitives import make_factory
+from dial.scheduler.log import EventLog
+from dial.scheduler.runner import Runner
+from dial.scheduler.signals import StopRequest, catch_stop_signals
+from dial.scheduler.ticks import Progress
+
+DEFAULT_TICK = 0.25  # s, when neither the script (@tick) nor the command line sets one
+MAX_TICK = 60.0  # s, as @tick's range
+
+
+@dataclass
+class RunOptions:
+    """How to run a script; the fields of ``dial run``'s options (see ``dial run --help``)."""
+
+    tick: float | None = None  # s; default: the script's @tick, else DEFAULT_TICK
+    speed: float = 1.0  # divides the tick
+    seed: int = 0
+    perturb_mm: float = 0.0
+    disturb: Sequence[Disturbance] = ()
+    realtime: bool = False
+    log: TextIO | None = None  # the JSON Lines sink, written and flushed record by record
+    log_states: bool = False
+    progress: Progress | None = None
+    observers: list[Observer] = field(default_factory=list)
+
+
+def tick_length(script: Script, options: RunOptions) -> float:
+    """The tick the run uses, in s: ``--tick``, else ``@tick``, else the default; / speed."""
+    tick = options.tick if options.tick is not None else (script.tick or DEFAULT_TICK)
+    if not (math.isfinite(options.speed) and options.speed > 0):
+        raise DialError(f"--speed must be a positive number, got {options.speed:g}")
+    if not (math.isfinite(tick) and 0 < tick / options.speed <= MAX_TICK):
+        raise DialError(
+            f"the tick must be above 0 s and at most {MAX_TICK:g} s, got {tick / options.speed:g}"
+        )
+    return tick / options.speed
+
+
+def run(script: Script, options: RunOptions) -> RunResult:
+    """Run ``script`` to its end (or its abort, or a stop signal) and measure the criteria.
+
+    SIGINT and SIGTERM stop the run at the next control period, from the scene's loading on:
+    every effector holds, and the log ends with ``interrupted`` and ``summary``.
+    """
+    stop = StopRequest()
+    with catch_stop_signals(stop):
+        log = EventLog(options.log)
+        tick = tick_length(script, options)
+        robot, ctx = prepare(script, log, options.perturb_mm, options.seed, options.disturb)
+        observers = ([StateLog()] if options.log_states else []) + list(options.observers)
+        begun: list[Observer] = []
+        result: RunResult | None = None
+        try:  # observers end also on an error: a recording keeps what was seen
+            for observer in observers:
+                observer.begin(Watched(robot, ctx.world, log))
+                begun.append(observer)
+            runner = Runner(
+                robot,
+                make_factory(ctx),
+                tick,
+                log,
+                progress=options.progress,
+                observe=fan_out(begun),
+                pace=1.0 if options.realtime else None,
+                stop=stop,
+            )
+            start, cpu = time.perf_counter(), time.process_time()
+            summary = trio.run(runner.run, script)
+            wall, cpu = time.perf_counter() - start, time.process_time() - cpu
+            criteria = measure_criteria(ctx.world, robot.model, robot.data, ctx.results)
+            result = RunResult(
+                summary,
+                ctx.world,
+                criteria,
+                dict(ctx.results),
+                wall,
+                cpu,
+                robot.steps,
+                log,
+                [float(x) for x in robot.data.qpos],
+                tuple(d.text for d in options.disturb),
+            )
+            log.write("summary", **result.as_record())
+            return result
+        finally:
+            for observer in begun:
+                observer.end(result)
