@@ -73,23 +73,30 @@ def test_hand_problem() -> None:
     )
 
 
-def test_a_pose_beyond_a_joint_range_is_an_error_at_scene(tmp_path: Path) -> None:
-    world = tmp_path / "w.toml"
-    world.write_text('extends = "surface"\n[poses.fist]\nindex = [0, 120, 0, 0]\n')
-    with pytest.raises(WorldFileError, match=r"poses\.fist\.index\.mcp: 120 deg is beyond"):
+@pytest.mark.parametrize(
+    ("table", "message"),
+    [
+        (
+            "[poses.fist]\nindex = [0, 120, 0, 0]",
+            "poses.fist.index.mcp: 120 deg is beyond the mcp joint's upper limit of 90 deg by "
+            "30 deg (its range is -20 to 90 deg)",
+        ),
+        (
+            '[programs]\nspin = "DRIVE 5 250"',
+            "programs.spin line 1: a drive of 250 deg takes PUMA joint 5 beyond its range "
+            "(-100 to 100 deg, 200 deg in all) by 50 deg from wherever it starts",
+        ),
+    ],
+    ids=["pose", "stored-drive"],
+)
+def test_a_world_beyond_a_joint_range_is_an_error_at_scene(
+    tmp_path: Path, table: str, message: str
+) -> None:
+    (tmp_path / "w.toml").write_text(f'extends = "surface"\n{table}\n')
+    with pytest.raises(WorldFileError) as e:
         load_scene_names("w.toml", tmp_path)
+    assert str(e.value).endswith(message)
     with pytest.raises(ScriptError) as info:
         check_text("@scene w.toml\n", str(tmp_path / "s.dial"), loader=load_scene_names)
     (d,) = info.value.diagnostics
-    assert (d.span.line, d.span.col) == (1, 8)
-    assert d.message.endswith(
-        "poses.fist.index.mcp: 120 deg is beyond the mcp joint's upper limit of 90 deg by "
-        "30 deg (its range is -20 to 90 deg)"
-    )
-
-
-def test_a_drive_beyond_range_in_a_stored_program_is_an_error(tmp_path: Path) -> None:
-    world = tmp_path / "w.toml"
-    world.write_text('extends = "surface"\n[programs]\nspin = "DRIVE 5 250"\n')
-    with pytest.raises(WorldFileError, match=r"programs\.spin line 1: a drive of 250 deg takes"):
-        load_scene_names("w.toml", tmp_path)
+    assert (d.span.line, d.span.col) == (1, 8) and d.message.endswith(message)
