@@ -70,7 +70,8 @@ class _Checker:
         self.program = program
         self.ctx = ctx
         self.origin = origin  # the real file, for resolving @call and @scene paths
-        self.lines = source.split("\n")
+        self.source = source
+        self.lines: list[str] | None = None  # split on the first problem: most checks have none
         self.events: dict[str, EventDef] = {}
         self.broken: set[str] = set()  # defined, but the definition has errors
         self.shown: set[str] = set()  # events that appear in a diagram
@@ -78,6 +79,8 @@ class _Checker:
         self.scene_failed = False
 
     def error(self, span: Span, message: str) -> None:
+        if self.lines is None:
+            self.lines = self.source.split("\n")
         text = self.lines[span.line - 1] if 0 < span.line <= len(self.lines) else ""
         self.ctx.diags.append(Diagnostic(self.program.path, span, message, text))
 
@@ -307,12 +310,19 @@ def _check_file(path: Path, display: str, ctx: _Context) -> Script:
 @contextmanager
 def _no_gc() -> Iterator[None]:
     """Pause the cyclic garbage collector: a script's tree holds no cycles, and on a large
-    script its full collections would make the check's cost grow faster than its size."""
+    script its collections would make the check's cost grow faster than its size.
+
+    Afterwards, freezing and at once unfreezing moves what the check made into the oldest
+    generation without a pass over it (a young-generation pass over a large script's tree
+    costs a fifth of its check); it stays collectable there, as any long-lived data.
+    """
     enabled = gc.isenabled()
     gc.disable()
     try:
         yield
     finally:
+        gc.freeze()
+        gc.unfreeze()
         if enabled:
             gc.enable()
 

@@ -120,12 +120,17 @@ def compile_block(block: Block, checks: Checks) -> TBlock:
                 Watch(line.event, line.line, w.start, w.end, line.span_of(w.start, w.end))
                 for w in line.watches
             )
-        name, number, effectors = line.event, line.line, event.effectors
-        runs += [Run(name, number, s, e, h, effectors, line.span_of(s, h)) for s, e, h in line.runs]
-    runs.sort(key=_START_LINE)
-    conflicts(runs, checks)
-    watches.sort(key=_START_LINE)
-    overlapping_watches(watches, checks)
+        name, number, effectors, col = line.event, line.line, event.effectors, line.column
+        runs += [
+            Run(name, number, s, e, h, effectors, Span(number, s + col - 1, h + col))
+            for s, e, h in line.runs
+        ]
+    if len(runs) > 1:
+        runs.sort(key=_START_LINE)
+        conflicts(runs, checks)
+    if len(watches) > 1:
+        watches.sort(key=_START_LINE)
+        overlapping_watches(watches, checks)
     reactions = tuple(
         TOn(r.condition, compile_body(r.body, checks), r.line) for r in block.reactions
     )

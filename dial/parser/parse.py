@@ -97,7 +97,6 @@ class _Parser:
     def __init__(self, text: str, path: str, depth: int = 0) -> None:
         self.path = path
         self.lines, problems = scan(text)
-        self.by_number = {ln.number: ln for ln in self.lines}
         self.diags: list[Diagnostic] = []
         for span, message in problems:
             self.error(span, message)
@@ -110,7 +109,7 @@ class _Parser:
         self.tick_value: float | None = None
 
     def error(self, span: Span, message: str) -> None:
-        ln = self.by_number.get(span.line)
+        ln = self.lines[span.line - 1] if 0 < span.line <= len(self.lines) else None  # numbered 1..
         self.diags.append(Diagnostic(self.path, span, message, ln.text if ln else ""))
 
     # -- driver ---------------------------------------------------------------------------
@@ -133,6 +132,9 @@ class _Parser:
                 self.other(ln)
         self.flush()
         body = self.structure.finish()
+        # The structure reports through this parser: drop it, so that no reference cycle
+        # keeps the lines alive until a garbage collection.
+        del self.structure
         return Program(
             self.path,
             self.scene,
@@ -231,6 +233,7 @@ class _Parser:
         if not pending:
             return
         base = min([p.first_col for p in pending])
+        self.structure.watching = self.structure.watching or any(p.marks.watches for p in pending)
         lines = tuple([self.exec_line(p, base) for p in pending])
         length = max(x.last_tick for x in lines)
         self.structure.add(Block(lines, length, pending[0].number), lines[0].event_span)

@@ -66,6 +66,7 @@ class Structure:
         self.base = depth  # the nesting level of the '@call' that runs this script
         self.stack: list[_Frame] = [_Frame("top", Span(1, 1, 2))]
         self.lenient: set[int] = set()  # blocks whose '@on' headers were broken
+        self.watching = False  # some block watches an event: its '@on' must be checked
 
     @property
     def nested(self) -> bool:
@@ -104,7 +105,8 @@ class Structure:
             frame = self.stack.pop()
             self.error(frame.span, f"'@{frame.kind}' is never closed: add '@end'")
         body = tuple(self.stack[0].statements)
-        self.unhandled_watches(body)
+        if self.watching:
+            self.unhandled_watches(body)
         return body
 
     def unhandled_watches(self, body: tuple[Statement, ...]) -> None:
