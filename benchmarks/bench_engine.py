@@ -12,7 +12,10 @@ Prints:
   of a run's wall time to the time it spent inside mj_step (timed call by call) is measured
   within one span and is the steadiest figure.
   A loop from the scene's rest state, which the robot never disturbs, is printed beside it;
-- the run's real-time factor;
+- the run's real-time factor (goal for pour.dial: >= 20 on one core);
+- for a script in the pour scene, the bare physics of that run per simulated second beside
+  that of the same script in the pour scene as it was before issue 16
+  (benchmarks/pour_before/), each replayed from its own run, and their ratio (target >= 3);
 - the scheduler's cost per event run on the fake robot, beside an equivalent py_trees tree
   (needs the `bench` extra: pip install -e ".[bench]").
 
@@ -23,6 +26,7 @@ from __future__ import annotations
 
 import argparse
 import time
+from pathlib import Path
 from types import SimpleNamespace
 
 import mujoco
@@ -33,15 +37,17 @@ from dial.backend.model import load_model
 from dial.engine import RunOptions, RunResult, run
 from dial.parser import Script, check_text, load
 from dial.resources import resolve_script
-from dial.scene import load_scene_names
+from dial.scene import World, load_scene_names, worlds_dir
 from dial.testing import run_fake
+
+POUR_BEFORE = Path(__file__).resolve().parent / "pour_before" / "pour_before.toml"
 
 
 class _StepRecorder:
     """Stands in for the driver's ``mujoco`` module: records what each mj_step call got."""
 
     def __init__(self) -> None:
-        self.start: np.ndarray | None = None
+        self.start: mujoco.MjData | None = None
         self.calls: list[tuple[np.ndarray, np.ndarray, int]] = []
 
     def __getattr__(self, name: str) -> object:
@@ -49,11 +55,35 @@ class _StepRecorder:
 
     def mj_step(self, model: mujoco.MjModel, data: mujoco.MjData, nstep: int = 1) -> None:
         if self.start is None:
-            spec = mujoco.mjtState.mjSTATE_INTEGRATION
-            self.start = np.empty(mujoco.mj_stateSize(model, spec))
-            mujoco.mj_getState(model, data, self.start, spec)
+            # The whole MjData, not mj_getState: restoring a state wakes every sleeping body
+            # (MuJoCo 4), and the pour scene starts with its objects asleep.
+            self.start = mujoco.MjData(model)
+            mujoco.mj_copyData(self.start, model, data)
         self.calls.append((data.ctrl.copy(), data.eq_active.copy(), nstep))
         mujoco.mj_step(model, data, nstep=nstep)
+
+
+class _Replay:
+    """A recorded run's physics steps, replayed from its start state on a fresh model."""
+
+    def __init__(self, recorder: _StepRecorder, model_path: Path) -> None:
+        assert recorder.start is not None
+        self.recorder = recorder
+        self.model = load_model(model_path)
+        self.data = mujoco.MjData(self.model)
+        self.steps = sum(nstep for _, _, nstep in recorder.calls)
+        self.sim_time = self.steps * self.model.opt.timestep
+
+    def run(self) -> tuple[float, float]:
+        """Replay once; (wall, process CPU) seconds."""
+        model, data = self.model, self.data
+        mujoco.mj_copyData(data, model, self.recorder.start)
+        t0, c0 = time.perf_counter(), time.process_time()
+        for ctrl, eq_active, nstep in self.recorder.calls:
+            data.ctrl[:] = ctrl
+            data.eq_active[:] = eq_active
+            mujoco.mj_step(model, data, nstep=nstep)
+        return time.perf_counter() - t0, time.process_time() - c0
 
 
 class _StepTimer(SimpleNamespace):
@@ -80,24 +110,19 @@ def _run_with(stand_in: object, script: Script) -> RunResult:
         driver.mujoco = mujoco
 
 
-def engine_overhead(script_arg: str, repeat: int) -> None:
-    script = load(resolve_script(script_arg), loader=load_scene_names)
-    # One recorded run gives the controls to replay; it is not timed (the recorder has its
-    # own cost). Runs are deterministic, so every timed run steps the same physics.
+def _record(script: Script) -> tuple[RunResult, _Replay]:
+    """One run with the step recorder (not timed: the recorder has its own cost)."""
     recorder = _StepRecorder()
     recorded = _run_with(recorder, script)
-    model = load_model(recorded.world.model_path)
-    data = mujoco.MjData(model)
-    assert recorder.start is not None
+    return recorded, _Replay(recorder, recorded.world.model_path)
 
-    def replay() -> tuple[float, float]:
-        mujoco.mj_setState(model, data, recorder.start, mujoco.mjtState.mjSTATE_INTEGRATION)
-        t0, c0 = time.perf_counter(), time.process_time()
-        for ctrl, eq_active, nstep in recorder.calls:
-            data.ctrl[:] = ctrl
-            data.eq_active[:] = eq_active
-            mujoco.mj_step(model, data, nstep=nstep)
-        return time.perf_counter() - t0, time.process_time() - c0
+
+def engine_overhead(script_arg: str, repeat: int) -> tuple[World, _Replay]:
+    """Print the overhead figures; return the run's world and replay. Runs are deterministic,
+    so every timed run steps the same physics as the recorded one."""
+    script = load(resolve_script(script_arg), loader=load_scene_names)
+    _, replay = _record(script)
+    model, data = replay.model, replay.data
 
     # Interleaved pairs, so that a noisy neighbour slows a run and its replay alike.
     walls, replays, cpu_ratios, inside = [], [], [], []
@@ -105,7 +130,7 @@ def engine_overhead(script_arg: str, repeat: int) -> None:
         timer = _StepTimer()
         result = _run_with(timer, script)
         inside.append(result.wall_time / timer.seconds)
-        bare_wall, bare_cpu = replay()
+        bare_wall, bare_cpu = replay.run()
         walls.append(result.wall_time)
         replays.append(bare_wall)
         cpu_ratios.append(result.cpu_time / bare_cpu)
@@ -132,8 +157,33 @@ def engine_overhead(script_arg: str, repeat: int) -> None:
     own = sorted(inside)[len(inside) // 2]
     print(f"  overhead ratio within the run    {own:8.3f}   (wall / time inside mj_step; median)")
     print(f"  overhead ratio vs scene at rest  {wall / idle:8.3f}")
-    print(f"  real-time factor                 {result.summary.sim_time / wall:8.2f}")
+    goal = "   (goal for pour.dial: >= 20 on one core)" if _is_pour(result.world) else ""
+    print(f"  real-time factor                 {result.summary.sim_time / wall:8.2f}{goal}")
     print(f"  task succeeded                   {result.ok}")
+    return result.world, replay
+
+
+def _is_pour(world: World) -> bool:
+    return world.path.resolve() == (worlds_dir() / "pour.toml").resolve()
+
+
+def pour_physics(script_arg: str, today: _Replay, repeat: int) -> None:
+    """Bare physics per simulated second: the same script in the pour scene before issue 16
+    and today, each replaying its own run; interleaved pairs, CPU time."""
+    script = load(resolve_script(script_arg), loader=load_scene_names, scene=str(POUR_BEFORE))
+    recorded, before = _record(script)
+    costs: tuple[list[float], list[float]] = ([], [])
+    for _ in range(repeat):
+        for replay, cost in zip((before, today), costs, strict=True):
+            cost.append(replay.run()[1] / replay.sim_time)
+    ratios = sorted(b / t for b, t in zip(*costs, strict=True))
+    print(f"{script_arg}: bare physics per simulated second, each scene replaying its own run")
+    print(f"  {repeat} interleaved pairs; ratio per pair:", " ".join(f"{r:.2f}" for r in ratios))
+    for name, replay, cost in (("before issue 16", before, costs[0]), ("today", today, costs[1])):
+        ms, steps = min(cost) * 1e3, replay.steps
+        print(f"  {name:<16} {ms:8.1f} ms CPU per simulated s (best; {steps} steps)")
+    print(f"  ratio before / today, median pair {ratios[len(ratios) // 2]:6.2f}   (target >= 3)")
+    print(f"  before: {POUR_BEFORE.parent.name}/ (succeeded: {recorded.ok})")
 
 
 def _fake_cost(text: str) -> tuple[float, int]:
@@ -229,7 +279,9 @@ def main() -> None:
     ap.add_argument("--runs", type=int, default=4000, help="event runs for the scheduler cost")
     ap.add_argument("--repeat", type=int, default=5, help="timed pairs of a run and a replay")
     args = ap.parse_args()
-    engine_overhead(args.script, args.repeat)
+    world, replay = engine_overhead(args.script, args.repeat)
+    if _is_pour(world):
+        pour_physics(args.script, replay, args.repeat)
     scheduler_cost(args.runs)
 
 

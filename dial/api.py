@@ -24,13 +24,15 @@ from dial.disturb import Disturbance, parse_disturbance
 from dial.errors import DialError, OptionError
 from dial.instructions.scene_names import SceneNotFoundError
 from dial.parser.check import load as parse_and_check
-from dial.parser.script import Script
+from dial.parser.script import Script, Step, TBlock, TCall, TIf, TRepeat
 from dial.resources import resolve_script
 from dial.scene import load_scene_names
 from dial.scene.resolve import scene_option
 
-if TYPE_CHECKING:  # MuJoCo is imported only to run: `import dial` and checking stay light
+if TYPE_CHECKING:  # trio and MuJoCo load only to run: `import dial` and checking stay light
+    from dial.debug import Console
     from dial.engine import Observer, RunResult
+    from dial.engine.state import Saved
 
 Progress = Callable[[int, float, list[str]], None]
 
@@ -114,6 +116,11 @@ def run(
     realtime: bool = False,
     observers: Sequence[Observer] = (),
     progress: Progress | None = None,
+    breaks: Sequence[str] = (),
+    step: bool = False,
+    save_at: tuple[int, str | Path] | None = None,
+    resume: str | Path | None = None,
+    console: Console | None = None,
 ) -> RunResult:
     """Run a script in its scene, as ``dial run`` does, and return its :class:`RunResult`.
 
@@ -126,24 +133,46 @@ def run(
     watch the run; ``observers`` are your own (:class:`~dial.engine.Observer`). ``progress``
     is called after every tick with (tick, simulated s, running events).
 
+    Debugging (docs/debugging.md): ``breaks`` (``EVENT``, ``tick:N``, ``monitor``) and
+    ``step`` pause the run and read commands from ``console`` (default: the terminal, or
+    stdin line by line when it is not one); ``save_at=(N, FILE)`` writes a state file just
+    before the N-th block starts; ``resume=FILE`` goes on from one (with its tick, seed,
+    perturbation and disturbances: passing those too is an error).
+
     A stop signal (SIGINT, SIGTERM) ends the run cleanly: ``result.summary.interrupted``.
     """
     check_options(tick, speed, seed, perturb)
+    if resume is not None and (tick is not None or speed != 1.0 or seed or perturb or disturb):
+        raise OptionError(
+            "--resume takes the tick, seed, perturbation and disturbances from the state "
+            "file: give none of --tick, --speed, --seed, --perturb, --disturb with it"
+        )
     try:
         items = [d if not isinstance(d, str) else parse_disturbance(d) for d in disturb]
     except DialError as e:
         raise OptionError(str(e)) from None
+    if save_at is not None:
+        if save_at[0] < 1:
+            raise OptionError(f"--save-at block:N needs N >= 1, got {save_at[0]}")
+        writable(save_at[1], "the state file")
+    saved = None if resume is None else _load_state(Path(resume))
     _check_watching(record, video, rerun, viewer)  # before the script: usage comes first
     if isinstance(script, Script):
         if scene is not None:
             raise OptionError("scene= applies when loading: pass it to dial.load()")
     else:
         script = load(script, scene=scene)
+    from dial.debug import LineConsole, TerminalConsole, parse_break
     from dial.engine import RunOptions
     from dial.engine import run as run_engine
 
+    events = _event_names(script)
+    stops = [parse_break(b, events) for b in breaks]
+    if (stops or step) and console is None:
+        console = TerminalConsole() if sys.stdin.isatty() else LineConsole()
+
     with _log_sink(log) as sink:
-        watchers = _watchers(record, video, rerun, viewer, Path(script.path).name)
+        watchers = _watchers(record, video, rerun, viewer, script)
         options = RunOptions(
             tick=tick,
             speed=speed,
@@ -155,8 +184,40 @@ def run(
             log_states=log_states,
             progress=progress,
             observers=[*watchers, *observers],
+            breaks=stops,
+            step=step,
+            console=console,
+            save_at=None if save_at is None else (save_at[0], Path(save_at[1])),
+            resume=saved,
         )
         return run_engine(script, options)
+
+
+def _event_names(script: Script) -> set[str]:
+    """The events of a script and of every script it calls (``--break EVENT``)."""
+    names, todo, seen = set(), [script], set()
+    while todo:
+        current = todo.pop()
+        if current.path in seen:
+            continue
+        seen.add(current.path)
+        names |= set(current.events)
+        todo += list(_callees(current.timeline))
+    return names
+
+
+def _callees(steps: tuple[Step, ...]) -> Iterator[Script]:
+    for step in steps:
+        if isinstance(step, TCall):
+            yield step.script
+        elif isinstance(step, TBlock):
+            for on in step.reactions:
+                yield from _callees(on.body)
+        elif isinstance(step, TRepeat):
+            yield from _callees(step.body)
+        elif isinstance(step, TIf):
+            yield from _callees(step.then)
+            yield from _callees(step.orelse)
 
 
 def _check_watching(
@@ -184,16 +245,18 @@ def _check_watching(
 
 
 def _watchers(
-    record: str | Path | None, video: str | Path | None, rerun: bool, viewer: bool, title: str
+    record: str | Path | None, video: str | Path | None, rerun: bool, viewer: bool, script: Script
 ) -> list[Observer]:
     """The observers behind ``record``, ``video``, ``rerun`` and ``viewer`` (checked)."""
     watchers: list[Observer] = []
     if record is not None or rerun:
+        from dial.parser.lanes import LanePlan
         from dial.recording.observers import Recorder
         from dial.recording.rerun_sink import RerunSink
 
         path = None if record is None else Path(record)
-        watchers.append(Recorder(RerunSink(path, spawn=rerun), title))
+        sink = RerunSink(path, spawn=rerun)  # the lanes in script order:
+        watchers.append(Recorder(sink, Path(script.path).name, plan=LanePlan.from_script(script)))
     if video is not None:
         from dial.recording.video import VideoWriter
 
@@ -203,3 +266,9 @@ def _watchers(
 
         watchers.append(PassiveViewer())
     return watchers
+
+
+def _load_state(path: Path) -> Saved:
+    from dial.engine.state import load as load_state  # MuJoCo loads only to run
+
+    return load_state(path)

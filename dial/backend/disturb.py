@@ -69,6 +69,14 @@ class Disturbances:
             windows.append(_Window(item, round(item.at / dt), end, body))
         return cls(tuple(windows))
 
+    def resume_at(self, step: int) -> None:
+        """Take up the disturbances acting at ``step`` (a run resumed from a state file; the
+        forces are in the saved physics already)."""
+        self._active = [
+            w for w in self.windows if w.begin < step and (w.end is None or step < w.end)
+        ]
+        self.dropping = any(isinstance(w.item, Dropout) for w in self._active)
+
     def due(self, step: int, substeps: int) -> bool:
         """Whether one begins or ends within the next ``substeps`` physics steps."""
         return any(step <= b < step + substeps for b in self._boundaries)

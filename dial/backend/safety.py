@@ -32,8 +32,8 @@ class Safety:
         self._arm_lo = arm_range[:, 0] - LIMIT_SLACK
         self._arm_hi = arm_range[:, 1] + LIMIT_SLACK
         self._pinned_at = index.tension_limit - 1e-6
-        self._saturated_since = np.full(32, -1.0)
-        self._saturation_logged = np.zeros(32, dtype=bool)
+        self.saturated_since = np.full(32, -1.0)
+        self.saturation_logged = np.zeros(32, dtype=bool)
 
     def check(self, time: float, happened: list[Happening]) -> str | None:
         """A fault message, or None; appends a ``warning`` for a tendon held at its limit."""
@@ -50,13 +50,13 @@ class Safety:
         # A tendon pinned at its limit is not a fault (a fist pressed into the palm does it),
         # but a researcher should know: log it once per episode.
         pinned = d.sensordata[ix.tension_sensors] >= self._pinned_at
-        if not pinned.any() and not self._saturation_logged.any():
-            self._saturated_since.fill(-1.0)
+        if not pinned.any() and not self.saturation_logged.any():
+            self.saturated_since.fill(-1.0)
             return None
-        self._saturated_since[~pinned] = -1.0
-        self._saturated_since[pinned & (self._saturated_since < 0)] = time
-        held = pinned & (time - self._saturated_since >= SATURATION_LIMIT_S)
-        for k in np.flatnonzero(held & ~self._saturation_logged):
+        self.saturated_since[~pinned] = -1.0
+        self.saturated_since[pinned & (self.saturated_since < 0)] = time
+        held = pinned & (time - self.saturated_since >= SATURATION_LIMIT_S)
+        for k in np.flatnonzero(held & ~self.saturation_logged):
             joint = int(k) // 2
             message = (
                 f"{FINGERS[joint // 4]} joint {joint % 4} "
@@ -64,5 +64,5 @@ class Safety:
                 f"{ix.tension_limit:g} N limit for {SATURATION_LIMIT_S:g} s"
             )
             happened.append(Happening("warning", {"t": time, "message": message}))
-        self._saturation_logged = held | (self._saturation_logged & pinned)
+        self.saturation_logged = held | (self.saturation_logged & pinned)
         return None

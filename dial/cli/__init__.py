@@ -11,7 +11,7 @@ import sys
 from collections.abc import Sequence
 
 from dial import __version__
-from dial.cli import replay, run, text, tune
+from dial.cli import replay, run, teach, text, tune
 from dial.errors import DialError, OptionError, ScriptError
 
 EPILOG = """\
@@ -36,6 +36,7 @@ def build_parser() -> argparse.ArgumentParser:
     replay.add_parser(sub)
     text.add_parsers(sub)
     tune.add_parser(sub)
+    teach.add_parsers(sub)
     return parser
 
 

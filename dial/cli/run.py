@@ -81,6 +81,34 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         "--rerun", action="store_true", help="stream the recording to a spawned rerun viewer"
     )
     p.add_argument("--viewer", action="store_true", help="watch in MuJoCo's viewer, in real time")
+    debug = p.add_argument_group(
+        "debugging (docs/debugging.md)",
+        "A paused run reads commands from the terminal, or line by line from stdin when it is "
+        "not one: continue, tick, period, state, save FILE, quit, help.",
+    )
+    debug.add_argument(
+        "--break",
+        dest="breaks",
+        action="append",
+        default=[],
+        metavar="EVENT|tick:N|monitor",
+        help="pause before a run of EVENT starts, at the start of absolute tick N, or after a "
+        "monitor fires; repeatable",
+    )
+    debug.add_argument("--step", action="store_true", help="pause at the start of every tick")
+    debug.add_argument(
+        "--save-at",
+        nargs=2,
+        metavar=("block:N", "FILE"),
+        help="write a state file just before the N-th block the run starts (a repeated block "
+        "counts each time; 'dial show' numbers the blocks)",
+    )
+    debug.add_argument(
+        "--resume",
+        metavar="FILE",
+        help="go on from a state file (with its tick, seed, perturbation and disturbances); "
+        "lines of the script before the saved block must be unchanged",
+    )
     p.set_defaults(func=cmd_run)
 
 
@@ -88,6 +116,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     if args.log_states and not args.log:
         raise UsageError("--log-states writes into the log: give --log FILE.jsonl too")
     api.check_options(args.tick, args.speed, args.seed, args.perturb)
+    save_at = _save_at(args.save_at)
     script = load_script(args.script, args.scene)
     result = api.run(
         script,
@@ -104,7 +133,13 @@ def cmd_run(args: argparse.Namespace) -> int:
         viewer=args.viewer,
         realtime=args.realtime,
         progress=_progress(args.quiet),
+        breaks=args.breaks,
+        step=args.step,
+        save_at=save_at,
+        resume=args.resume,
     )
+    for number, target in result.saved:
+        print(f"dial: saved the state before block {number} to {target}", file=sys.stderr)
     if not args.quiet and sys.stderr.isatty():
         sys.stderr.write("\r" + " " * 100 + "\r")
     if not args.quiet:
@@ -118,7 +153,25 @@ def cmd_run(args: argparse.Namespace) -> int:
         print(json.dumps(result.as_record()))
     if stopped is not None:
         return EXIT_STATUS.get(stopped, 130)
+    if save_at is not None and not result.saved:
+        print(
+            f"dial: --save-at block:{save_at[0]}: the run started fewer blocks; nothing was saved",
+            file=sys.stderr,
+        )
+        return 1
     return 0 if result.ok else 1
+
+
+def _save_at(value: list[str] | None) -> tuple[int, str] | None:
+    """``--save-at block:N FILE`` as (N, FILE)."""
+    if value is None:
+        return None
+    where, target = value
+    digits = where.removeprefix("block:")
+    number = digits.isascii() and digits.isdigit() and len(digits) <= 9 and int(digits)
+    if not where.startswith("block:") or not number:
+        raise UsageError(f"--save-at: expected block:N FILE, N a block from 1; got '{where}'")
+    return number, target
 
 
 def _progress(quiet: bool) -> Callable[[int, float, list[str]], None] | None:

@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING, Protocol
 import numpy as np
 
 from dial.backend.driver import MujocoRobot
+from dial.parser.lanes import LanePlan
 from dial.scene.world import World
 from dial.scheduler.log import EventLog
 
@@ -68,16 +69,21 @@ class StateLog:
 
     A record holds ``t``, ``tick``, the whole ``qpos`` (the arm, the hand, and every free
     object) and the 32 tendon ``tension``s, which cannot be recomputed from positions. The
-    engine owns it: the engine and the runner are the log's only writers.
+    engine owns it: the engine and the runner are the log's only writers. With ``lanes``
+    (the script's event lanes), a ``lanes`` record comes first, so that a replayed recording
+    draws the same lanes.
     """
 
-    def __init__(self, rate_hz: float = STATE_HZ) -> None:
-        self.rate_hz = rate_hz
+    def __init__(self, rate_hz: float = STATE_HZ, lanes: LanePlan | None = None) -> None:
+        self.rate_hz, self.lanes = rate_hz, lanes
 
     def begin(self, run: Watched) -> None:
         self.robot: MujocoRobot = run.robot
         self.log: EventLog = run.log
         self.every = every(self.rate_hz, run.robot.period)
+        if self.lanes is not None:
+            record = self.lanes.as_record()
+            self.log.write(record.pop("kind"), **record)
         self._write(0, 0)
 
     def period(self, periods: int, tick: int) -> None:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import mujoco
 
@@ -55,6 +56,7 @@ class RunResult:
     log: EventLog
     final_qpos: list[float] = field(default_factory=list)
     disturbances: tuple[str, ...] = ()
+    saved: tuple[tuple[int, Path], ...] = ()  # (block number, state file) written
 
     @property
     def ok(self) -> bool:

@@ -11,17 +11,24 @@ import math
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import TextIO
 
 import trio
 
-from dial.disturb import Disturbance
+from dial.backend.driver import MujocoRobot
+from dial.backend.snapshot import Snapshot
+from dial.debug import Break, Console, Session
+from dial.disturb import Disturbance, parse_disturbance
+from dial.engine.debugging import session
 from dial.engine.observe import Observer, StateLog, Watched, fan_out
 from dial.engine.result import RunResult, measure_criteria
 from dial.engine.setup import prepare
+from dial.engine.state import RunSettings, Saved
 from dial.errors import DialError
+from dial.parser.lanes import LanePlan
 from dial.parser.script import Script
-from dial.primitives import make_factory
+from dial.primitives import Context, make_factory
 from dial.scheduler.log import EventLog
 from dial.scheduler.runner import Runner
 from dial.scheduler.signals import StopRequest, catch_stop_signals
@@ -45,6 +52,12 @@ class RunOptions:
     log_states: bool = False
     progress: Progress | None = None
     observers: list[Observer] = field(default_factory=list)
+    # Debugging (DESIGN 6.1): where to pause, where commands come from, what to save.
+    breaks: Sequence[Break] = ()
+    step: bool = False
+    console: Console | None = None
+    save_at: tuple[int, Path] | None = None  # (block number, state file)
+    resume: Saved | None = None  # a state file to go on from (its settings win)
 
 
 def tick_length(script: Script, options: RunOptions) -> float:
@@ -68,9 +81,22 @@ def run(script: Script, options: RunOptions) -> RunResult:
     stop = StopRequest()
     with catch_stop_signals(stop):
         log = EventLog(options.log)
-        tick = tick_length(script, options)
-        robot, ctx = prepare(script, log, options.perturb_mm, options.seed, options.disturb)
-        observers = ([StateLog()] if options.log_states else []) + list(options.observers)
+        settings = _settings(script, options)
+        disturb = [parse_disturbance(d) for d in settings.disturb]
+        robot, ctx = prepare(script, log, settings.perturb_mm, settings.seed, disturb)
+        resume = None
+        if options.resume is not None:
+            resume = options.resume.check(script)
+            options.resume.restore(robot, ctx)
+            log.write(
+                "resume",
+                file=str(options.resume.source),
+                block=resume.blocks + 1,
+                tick=resume.tick,
+                t=resume.periods * robot.period,
+            )
+        states = [StateLog(lanes=LanePlan.from_script(script))] if options.log_states else []
+        observers = states + list(options.observers)
         begun: list[Observer] = []
         result: RunResult | None = None
         try:  # observers end also on an error: a recording keeps what was seen
@@ -80,15 +106,17 @@ def run(script: Script, options: RunOptions) -> RunResult:
             runner = Runner(
                 robot,
                 make_factory(ctx),
-                tick,
+                settings.tick,
                 log,
                 progress=options.progress,
                 observe=fan_out(begun),
                 pace=1.0 if options.realtime else None,
                 stop=stop,
             )
+            hooks = _debugging(script, runner, robot, ctx, stop, settings, begun, options)
+            runner.hooks = hooks
             start, cpu = time.perf_counter(), time.process_time()
-            summary = trio.run(runner.run, script)
+            summary = trio.run(runner.run, script, resume)
             wall, cpu = time.perf_counter() - start, time.process_time() - cpu
             criteria = measure_criteria(ctx.world, robot.model, robot.data, ctx.results)
             result = RunResult(
@@ -101,10 +129,51 @@ def run(script: Script, options: RunOptions) -> RunResult:
                 robot.steps,
                 log,
                 [float(x) for x in robot.data.qpos],
-                tuple(d.text for d in options.disturb),
+                settings.disturb,
+                tuple(hooks.saved) if hooks is not None else (),
             )
             log.write("summary", **result.as_record())
             return result
         finally:
             for observer in begun:
                 observer.end(result)
+
+
+def _settings(script: Script, options: RunOptions) -> RunSettings:
+    """The tick, seed, perturbation and disturbances: a resumed run takes its state file's."""
+    if options.resume is not None:
+        return options.resume.settings
+    return RunSettings(
+        tick_length(script, options),
+        options.seed,
+        options.perturb_mm,
+        tuple(d.text for d in options.disturb),
+    )
+
+
+def _debugging(
+    script: Script,
+    runner: Runner[Snapshot],
+    robot: MujocoRobot,
+    ctx: Context,
+    stop: StopRequest,
+    settings: RunSettings,
+    observers: list[Observer],
+    options: RunOptions,
+) -> Session | None:
+    """The session's hooks, if the run pauses or saves; None keeps the runner's hot path lean."""
+    if not (options.breaks or options.step or options.save_at):
+        return None
+    return session(
+        script,
+        runner,
+        robot,
+        ctx,
+        stop,
+        settings,
+        observers,
+        options.console,
+        options.breaks,
+        options.step,
+        options.save_at,
+    )

@@ -55,10 +55,13 @@ def scene_bodies(model: mujoco.MjModel, world: World) -> list[int]:
     return sorted(named | free)
 
 
-def perturb(
-    model: mujoco.MjModel, data: mujoco.MjData, world: World, mm: float, seed: int
-) -> list[float]:
-    """Shift the scene's objects by ``mm`` in a seeded horizontal direction; the shift in m."""
+def perturb(model: mujoco.MjModel, world: World, mm: float, seed: int) -> list[float]:
+    """Shift the scene's objects by ``mm`` in a seeded horizontal direction; the shift in m.
+
+    It moves the model (a free body's initial position, a fixed object's position), before
+    any ``MjData`` is made from it: with sleeping on, MuJoCo places a fixed body only once,
+    when the data is made.
+    """
     if mm <= 0:
         return [0.0, 0.0, 0.0]
     angle = np.random.default_rng(seed).uniform(0.0, 2.0 * np.pi)
@@ -67,7 +70,7 @@ def perturb(
         joint = int(model.body_jntadr[body])
         if joint >= 0 and model.jnt_type[joint] == mujoco.mjtJoint.mjJNT_FREE:
             adr = int(model.jnt_qposadr[joint])
-            data.qpos[adr : adr + 3] += shift
+            model.qpos0[adr : adr + 3] += shift
         elif model.body_parentid[body] == 0 and model.body_jntnum[body] == 0:
             model.body_pos[body] += shift
     return [float(x) for x in shift]
@@ -84,13 +87,15 @@ def prepare(
     world = script_world(script)
     model = load_model(world.model_path)
     placed = Disturbances.on(model, disturbances)  # an unknown body fails before anything moves
-    data = mujoco.MjData(model)
     index = RobotIndex.from_model(model)
-    mujoco.mj_forward(model, data)
+    unmoved = mujoco.MjData(model)
+    mujoco.mj_forward(model, unmoved)
     believed: dict[str, Pose] = {
-        model.body(b).name: (data.xpos[b].copy(), data.xmat[b].reshape(3, 3).copy())
+        model.body(b).name: (unmoved.xpos[b].copy(), unmoved.xmat[b].reshape(3, 3).copy())
         for b in scene_bodies(model, world)
     }
+    shift = perturb(model, world, perturb_mm, seed)
+    data = mujoco.MjData(model)
     ik = ArmIK()
     if "home" in world.locations:
         pos, rot = location_pose(world, believed, "home")
@@ -100,7 +105,6 @@ def prepare(
     data.qpos[index.arm_qpos] = home
     data.ctrl[index.arm_actuators] = home
     data.ctrl[index.tendon_actuators] = hand_ctrl(data.qpos[index.hand_qpos])
-    shift = perturb(model, data, world, perturb_mm, seed)
     mujoco.mj_forward(model, data)
     for _ in range(round(SETTLE_S / model.opt.timestep)):
         mujoco.mj_step(model, data)

@@ -21,9 +21,13 @@ from dial.instructions.scene_names import SceneLoader, SceneNames, SceneNotFound
 from dial.instructions.types import EFFECTORS, Name
 from dial.parser.ast import Call, Condition, Definition, ExecLine, Program
 from dial.parser.bind import bind
-from dial.parser.compile import WATCHABLE, compile_body, diagram_events
+from dial.parser.compile import compile_body, diagram_events
 from dial.parser.parse import parse_partial
 from dial.parser.script import EventDef, Script
+
+# The instructions whose condition holds or not at each moment, so that a monitor can sense
+# it every control period: the contact conditions (DESIGN 2.7).
+WATCHABLE = tuple(name for name, i in INSTRUCTIONS.items() if i.condition is not None)
 
 
 def _hint(name: str, valid: list[str]) -> str:
@@ -223,7 +227,7 @@ class _Checker:
                 f"'{line.event}' ({instr.name}) commands {what}",
             )
             return False
-        if instr.name not in WATCHABLE:
+        if instr.condition is None:
             self.error(
                 line.span_of(*line.watches[0]),
                 f"event '{line.event}' ({instr.name}) cannot be watched: only "

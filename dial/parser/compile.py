@@ -40,9 +40,6 @@ from dial.parser.script import (
     Watch,
 )
 
-# The instructions whose condition holds or not at each moment, so that a monitor can
-# sense it every control period: the contact conditions.
-WATCHABLE = ("position_contact", "force_contact", "tactile_contact")
 _START_LINE = attrgetter("start", "line")
 
 

@@ -12,6 +12,7 @@ from pathlib import Path
 from typing import Any
 
 from dial.errors import DialError
+from dial.recording.lanes import lane_key
 
 Record = Mapping[str, Any]
 BAD_OUTCOMES = {"missed": "warn", "timeout": "error", "error": "error"}
@@ -53,8 +54,7 @@ def when(record: Record, tick: int) -> tuple[float, int]:
 def qualified_event(record: Record) -> str:
     """The event of a ``start`` or ``end`` record; a called script's events carry that
     script's name (``explore_surface.reach``), since event names repeat across scripts."""
-    script = record.get("script")
-    return f"{Path(script).stem}.{record['event']}" if script else str(record["event"])
+    return ".".join(lane_key(record))
 
 
 def describe(record: Record) -> tuple[str, str] | None:
@@ -82,6 +82,9 @@ def describe(record: Record) -> tuple[str, str] | None:
         return f"condition {record['condition']} is {str(record['value']).lower()}{where}", "info"
     if kind == "call":
         return f"call {record['script']}", "info"
+    if kind == "block":
+        where = f" of {Path(record['script']).name}" if record.get("script") else ""
+        return f"block {record['number']} (line {record['line']}{where})", "info"
     if kind == "contact":
         return (
             f"contact: {record['sensor']} on the {record['finger']} stopped the "
@@ -90,10 +93,17 @@ def describe(record: Record) -> tuple[str, str] | None:
         )
     if kind == "thread":
         return f"thread {record['name']} released", "info"
+    if kind == "monitor":
+        return f"monitor '@on {record['condition']}' (line {record['line']}) fired", "warn"
+    if kind == "disturb":
+        return f"disturbance {record['phase']}s: {record['what']}", "warn"
     if kind in ("warning", "error"):
         return str(record["message"]), "warn" if kind == "warning" else "error"
     if kind == "interrupted":
-        return "interrupted; every effector holds its pose", "error"
+        why = f" by {record['signal']}" if record.get("signal") else ""
+        return f"interrupted{why}; every effector holds its pose", "error"
+    if kind == "resume":
+        return f"resumed from {record['file']} at block {record['block']}", "info"
     if kind == "summary":
         criteria = record.get("criteria", {})
         marks = "; ".join(

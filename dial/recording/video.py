@@ -15,8 +15,8 @@ from typing import Any
 import mujoco
 
 from dial.engine import RunResult, Watched
+from dial.engine.observe import every
 from dial.errors import DialError
-from dial.recording.frames import every
 from dial.recording.geometry import Camera, task_camera
 from dial.recording.observers import object_bodies
 
@@ -43,11 +43,16 @@ def first_line(e: BaseException) -> str:
 
 
 class Renderer:
-    """Frames of the scene from a fixed camera, as (HEIGHT, WIDTH, 3) uint8 RGB arrays."""
+    """Frames of the scene from a fixed camera, as (height, width, 3) uint8 RGB arrays."""
 
-    def __init__(self, model: mujoco.MjModel, camera: Camera) -> None:
+    def __init__(
+        self, model: mujoco.MjModel, camera: Camera, width: int = WIDTH, height: int = HEIGHT
+    ) -> None:
+        # A frame larger than the model's offscreen buffer needs a larger buffer.
+        model.vis.global_.offwidth = max(int(model.vis.global_.offwidth), width)
+        model.vis.global_.offheight = max(int(model.vis.global_.offheight), height)
         try:
-            self.renderer = mujoco.Renderer(model, HEIGHT, WIDTH)
+            self.renderer = mujoco.Renderer(model, height, width)
         except Exception as e:  # the GL backends raise assorted errors
             raise DialError(
                 f"cannot render offscreen ({first_line(e)}); on Linux without a display, "

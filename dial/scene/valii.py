@@ -11,7 +11,6 @@ import math
 import re
 from dataclasses import dataclass
 
-from dial.instructions.limits import drive_problem
 from dial.units import UnitError, parse_quantity
 
 NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
@@ -86,11 +85,7 @@ def parse_statement(text: str, line: int = 1) -> Statement | None:
         return Appro(line, _name(args[0]), _length(args[1], 0.0, MAX_APPROACH))
     if verb == "DEPART":
         return Depart(line, _length(args[0], -MAX_APPROACH, MAX_APPROACH))
-    joint, angle = _joint(args[0]), _angle(args[1])
-    problem = drive_problem(joint, angle)
-    if problem is not None:
-        raise StatementError(problem)
-    return Drive(line, joint, angle)
+    return Drive(line, _joint(args[0]), _angle(args[1]))
 
 
 def _name(text: str) -> str:

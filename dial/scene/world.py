@@ -15,14 +15,14 @@ from pathlib import Path
 from types import MappingProxyType
 from typing import Any, Literal
 
-from dial.instructions.limits import hand_problem
+from dial.instructions.limits import drive_problem, hand_problem
 from dial.instructions.scene_names import SceneNames
 from dial.instructions.types import FINGERS
 from dial.scene.criteria import Criterion, parse_criterion
 from dial.scene.mjcf import body_names
 from dial.scene.reader import Reader, WorldFileError
 from dial.scene.resolve import resolve_scene
-from dial.scene.valii import NAME, Appro, Move, Statement, StatementError, parse_statement
+from dial.scene.valii import NAME, Appro, Drive, Move, Statement, StatementError, parse_statement
 
 JOINTS: tuple[str, ...] = ("abd", "mcp", "pip", "dip")  # joint j of a finger: bit 4*f + j
 AXES: tuple[str, ...] = ("object", "world")
@@ -237,6 +237,10 @@ def _program(reader: Reader, name: str, value: Any, locations: Mapping[str, Loca
             statement = parse_statement(line, number)
         except StatementError as e:
             raise reader.error(where, str(e)) from None
+        # A stored DRIVE turning further than its joint's whole range overshoots wherever it
+        # starts (a session, such as dial teach, checks a drive against the joint's angle).
+        if isinstance(statement, Drive) and (p := drive_problem(statement.joint, statement.angle)):
+            raise reader.error(where, p)
         if isinstance(statement, Move | Appro) and statement.location not in locations:
             valid = ", ".join(locations) or "(none)"
             raise reader.error(

@@ -67,6 +67,10 @@ class Records:
             record["preempted"] = True
         self.log.append(record)
 
+    def block(self, path: str, number: int, line: int, tick: int, t: float) -> None:
+        """The ``number``-th block the run starts (``--save-at block:N`` counts the same)."""
+        self.log.write("block", number=number, line=line, tick=tick, t=t, **self._whose(path))
+
     def condition(self, path: str, cond: Condition, value: bool, tick: int, t: float) -> None:
         self.log.write(
             "condition", condition=str(cond), value=value, tick=tick, t=t, **self._whose(path)

@@ -30,6 +30,7 @@ from dial.parser.script import (
     TRetry,
 )
 from dial.scheduler.log import EventLog
+from dial.scheduler.position import Frame, Hooks, Path, Resume
 from dial.scheduler.records import Records
 from dial.scheduler.signals import StopRequest, catch_stop_signals
 from dial.scheduler.ticks import Observe, Progress, TickLoop
@@ -77,22 +78,33 @@ class Runner(Generic[S]):
         observe: Observe | None = None,
         pace: float | None = None,
         stop: StopRequest | None = None,
+        hooks: Hooks | None = None,
     ) -> None:
         self.robot = robot
         self.n = periods_per_tick(tick, robot.period)
         self.log = log or EventLog()
         self.stop = stop or StopRequest()
+        self.hooks = hooks
+        self.blocks = 0  # blocks started so far (a repeated or retried block each time)
         self._factory = factory
         self._options = (progress, observe, pace)
+        self._path: list[Frame] = []  # where the walk is now
         self.loop: TickLoop[S] | None = None
 
-    async def run(self, script: Script) -> RunSummary:
-        """Run the script to its end, its abort or a stop signal; every effector then holds."""
+    async def run(self, script: Script, resume: Resume | None = None) -> RunSummary:
+        """Run the script to its end, its abort or a stop signal; every effector then holds.
+
+        ``resume``: go on from a saved block boundary instead of the first block.
+        """
         records = Records(self.log, script.path)
         progress, observe, pace = self._options
         loop = self.loop = TickLoop(
             self.robot, self._factory, self.n, records, self.stop, observe, progress, pace
         )
+        loop.hooks = self.hooks
+        if resume is not None:
+            loop.restore(resume)
+            self.blocks = resume.blocks
         error: RunAborted | None = None
         interrupted: str | None = None
         if pace is not None:
@@ -101,7 +113,8 @@ class Runner(Generic[S]):
             with catch_stop_signals(self.stop):
                 if self.stop.signal is not None:  # it came while the scene was being prepared
                     raise Interrupted(self.stop.signal)
-                await self._walk(loop, script, script.timeline)
+                path = resume.path if resume is not None else ()
+                await self._walk(loop, script, script.timeline, path)
         except RunAborted as e:
             error = e
             records.error(e.event, e.tick, loop.sim_time, str(e))
@@ -126,41 +139,74 @@ class Runner(Generic[S]):
 
     # -- the timeline walk ------------------------------------------------------------------------
     async def _walk(
-        self, loop: TickLoop[S], script: Script, steps: tuple[Step, ...]
+        self, loop: TickLoop[S], script: Script, steps: tuple[Step, ...], resume: Path = ()
     ) -> Ending | None:
-        """Run ``steps`` in order; return the reaction ending that stopped them, if any."""
-        for step in steps:
-            ending: Ending | None = None
-            if isinstance(step, TBlock):
-                await self._block(loop, script, step)
-            elif isinstance(step, TRepeat):
-                ending = await self._repeat(loop, script, step)
-            elif isinstance(step, TIf):
-                branch = step.then if self._test(loop, script, step.condition) else step.orelse
-                ending = await self._walk(loop, script, branch)
-            elif isinstance(step, TCall):
-                loop.records.call(step.script.path, loop.tick, loop.sim_time)
-                await self._walk(loop, step.script, step.script.timeline)
-            else:
-                return step  # @resume, @retry or @abort: the reaction ends here
+        """Run ``steps`` in order (from ``resume`` on, if given); return the reaction ending
+        that stopped them, if any."""
+        first = resume[0].step if resume else 0
+        for i in range(first, len(steps)):
+            at, inner = (resume[0], resume[1:]) if resume and i == first else (Frame(i), ())
+            self._path.append(at)
+            try:
+                ending = await self._step(loop, script, steps[i], at, inner)
+            finally:
+                self._path.pop()
             if ending is not None:
                 return ending
         return None
 
-    async def _block(self, loop: TickLoop[S], script: Script, block: TBlock) -> None:
+    async def _step(
+        self, loop: TickLoop[S], script: Script, step: Step, at: Frame, inner: Path
+    ) -> Ending | None:
+        if isinstance(step, TBlock):
+            await self._block(loop, script, step, at, inner)
+        elif isinstance(step, TRepeat):
+            return await self._repeat(loop, script, step, at, inner)
+        elif isinstance(step, TIf):
+            if inner:  # resumed inside the branch it took: its condition was tested then
+                then = at.detail == 0
+            else:
+                then = self._test(loop, script, step.condition)
+                self._path[-1] = Frame(at.step, 0 if then else 1)
+            return await self._walk(loop, script, step.then if then else step.orelse, inner)
+        elif isinstance(step, TCall):
+            if not inner:
+                loop.records.call(step.script.path, loop.tick, loop.sim_time)
+            await self._walk(loop, step.script, step.script.timeline, inner)
+        else:
+            return step  # @resume, @retry or @abort: the reaction ends here
+        return None
+
+    async def _block(
+        self, loop: TickLoop[S], script: Script, block: TBlock, at: Frame, inner: Path
+    ) -> None:
         """A block, and its reactions each time a monitor preempts it (DESIGN 2.7)."""
-        retries = 0
+        retries = at.detail
+        reacting = at.reaction  # resumed inside a reaction of this block
         while True:
-            preempted = await loop.block(script, block)
-            if preempted is None:
-                return
-            on = preempted.reaction
-            ending = await self._walk(loop, script, on.body)
+            if reacting < 0:
+                self._path[-1] = Frame(at.step, retries)
+                self.blocks += 1
+                if self.hooks is not None:
+                    await self.hooks.before_block(self.blocks, tuple(self._path), script, block)
+                loop.records.block(
+                    script.path, self.blocks, block.line, loop.tick + 1, loop.sim_time
+                )
+                preempted = await loop.block(script, block)
+                if preempted is None:
+                    return
+                reacting, fired_at = block.reactions.index(preempted.reaction), preempted.tick
+            else:
+                fired_at = loop.tick
+            on = block.reactions[reacting]
+            self._path[-1] = Frame(at.step, retries, reacting)
+            ending = await self._walk(loop, script, on.body, inner)
+            inner, reacting = (), -1
             where = f"the monitor '@on {on.condition}' (line {on.line} of {script.path})"
             if isinstance(ending, TAbort):
                 raise RunAborted(
                     f"@abort on line {ending.line} of {script.path}: {ending.message} "
-                    f"({where} fired at tick {preempted.tick})",
+                    f"({where} fired at tick {fired_at})",
                     on.condition.event,
                     loop.tick,
                 )
@@ -176,11 +222,19 @@ class Runner(Generic[S]):
                     loop.tick,
                 )
 
-    async def _repeat(self, loop: TickLoop[S], script: Script, step: TRepeat) -> Ending | None:
-        for _ in range(step.count):
-            if step.kind == "while" and not self._test(loop, script, step.condition):
+    async def _repeat(
+        self, loop: TickLoop[S], script: Script, step: TRepeat, at: Frame, inner: Path
+    ) -> Ending | None:
+        for k in range(at.detail, step.count):
+            self._path[-1] = Frame(at.step, k)
+            resumed = bool(inner) and k == at.detail  # its while-test was done before the save
+            if (
+                step.kind == "while"
+                and not resumed
+                and not self._test(loop, script, step.condition)
+            ):
                 return None
-            ending = await self._walk(loop, script, step.body)
+            ending = await self._walk(loop, script, step.body, inner if resumed else ())
             if ending is not None:
                 return ending
             if step.kind == "until" and self._test(loop, script, step.condition):

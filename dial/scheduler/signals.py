@@ -17,7 +17,8 @@ from contextlib import contextmanager
 from types import FrameType
 
 _NAMES = {signal.SIGINT: "SIGINT", signal.SIGTERM: "SIGTERM"}
-EXIT_STATUS = {"SIGINT": 130, "SIGTERM": 143}  # 128 + the signal number, as shells report
+# 128 + the signal number, as shells report; "quit" is a paused run's quit command.
+EXIT_STATUS = {"SIGINT": 130, "SIGTERM": 143, "quit": 130}
 
 
 class StopRequest:

@@ -17,6 +17,8 @@ import trio
 
 from dial.errors import DialError
 from dial.parser.script import Run, Script, TBlock, TOn, Watch
+from dial.scheduler.active import ActiveRun, RunPlan
+from dial.scheduler.position import Hooks, Resume
 from dial.scheduler.records import Records
 from dial.scheduler.signals import StopRequest
 from dial.scheduler.types import (
@@ -42,52 +44,6 @@ YIELD_EVERY = 64  # periods between trio checkpoints when not paced (other tasks
 
 Progress = Callable[[int, float, list[str]], None]  # (tick, sim time, running events)
 Observe = Callable[[int, int], None]  # (periods so far, tick), after every period
-
-
-class ActiveRun(Generic[S]):
-    """One started run in the table: its primitive and where it sits in time."""
-
-    __slots__ = (
-        "ended",
-        "fixed",
-        "info",
-        "prim",
-        "script",
-        "span",
-        "start_clock",
-        "start_period",
-        "timeout",
-    )
-
-    def __init__(
-        self, script: Script, plan: RunPlan, prim: Primitive[S], periods: int, clock: int
-    ) -> None:
-        self.script, self.info, self.prim = script, plan.info, prim
-        self.span, self.fixed, self.timeout = plan.span, plan.fixed, plan.timeout
-        self.start_period, self.start_clock = periods, clock  # periods, tick-time periods
-        self.ended: Ended | None = None
-
-
-class RunPlan(NamedTuple):
-    """What a run's place in the script fixes, worked out once per run of the timeline."""
-
-    info: RunInfo
-    span: int  # its executing ticks, in periods
-    fixed: bool  # fixed-length: it ends with its last executing tick
-    timeout: float | None  # s; only indeterminate runs time out
-
-    @classmethod
-    def of(cls, info: RunInfo) -> RunPlan:
-        run, event = info.run, info.event
-        fixed = event.instruction.length == "fixed"
-        timeout = event.args.get("timeout")
-        usable = not fixed and isinstance(timeout, int | float)
-        return cls(
-            info,
-            (run.exec_end - run.start + 1) * info.periods_per_tick,
-            fixed,
-            float(timeout) if usable else None,  # type: ignore[arg-type]
-        )
 
 
 class _Plan(NamedTuple):
@@ -134,12 +90,23 @@ class TickLoop(Generic[S]):
         self._ending = False  # some run ended this period: stop it after the period
         self._plans: dict[int, _Plan] = {}
         self._runs: dict[tuple[str, int], RunPlan] = {}
+        self.hooks: Hooks | None = None
         self._snap: S | None = None
         self.t0 = 0.0  # trio time at the first period, for pacing
 
     @property
     def sim_time(self) -> float:
         return self.periods * self.period
+
+    def progress_of(self, a: ActiveRun[S]) -> float:
+        """A run's progress in tick time now (0 to 1)."""
+        return 1.0 if a.span == self.n else min(1.0, (self.clock - a.start_clock) / a.span)
+
+    def restore(self, resume: Resume) -> None:
+        """Take up the clocks, outcomes and counts of a run saved at a block boundary."""
+        self.periods, self.clock, self.tick = resume.periods, resume.clock, resume.tick
+        self.latest.update(resume.latest)
+        self.counts.update(resume.counts)
 
     # -- one block ------------------------------------------------------------------------------
     async def block(self, script: Script, block: TBlock) -> Preempted | None:
@@ -150,6 +117,9 @@ class TickLoop(Generic[S]):
             for k in range(1, block.length + 1):
                 self.tick += 1
                 t0 = self.sim_time
+                if self.hooks is not None:
+                    await self.hooks.before_tick(self.tick, script, plan.starts.get(k, ()))
+                    self._raise_pending()  # a signal while paused
                 for watch in plan.watch_from.get(k, ()):
                     self._arm(script, block, watch, monitors)
                 for run in plan.starts.get(k, ()):
@@ -159,13 +129,13 @@ class TickLoop(Generic[S]):
                 for _ in range(self.n):
                     self.clock += 1
                     if fired := await self._period(stretched=False):
-                        return self._preempt(script, block, fired, monitors, k, t0, stretch)
+                        return await self._preempted(script, block, fired, monitors, k, t0, stretch)
                 # An indeterminate run still going at the end of its last tick stretches it.
                 stretching = self._finish(k)
                 while stretching:
                     stretch += 1
                     if fired := await self._period(stretched=True):
-                        return self._preempt(script, block, fired, monitors, k, t0, stretch)
+                        return await self._preempted(script, block, fired, monitors, k, t0, stretch)
                     stretching = any(a.info.run.exec_end == k for a in self.active)
                 for watch in plan.watch_to.get(k, ()):
                     self._disarm(monitors, watch)
@@ -221,7 +191,8 @@ class TickLoop(Generic[S]):
         if plan.info.event.instruction.length == "zero":
             self._sense(script, run, cast(Sensor[S], prim))
             return
-        active = ActiveRun(script, plan, cast(Primitive[S], prim), self.periods, self.clock)
+        prim_s = cast(Primitive[S], prim)
+        active = ActiveRun(script, plan, prim_s, self.tick, self.periods, self.clock)
         self.active.append(active)  # from here on, its stop runs whatever happens
         try:
             active.prim.start(self._snapshot())
@@ -250,6 +221,9 @@ class TickLoop(Generic[S]):
             await trio.sleep_until(self.t0 + self.periods * self.period * self.pace)
         elif self.periods % YIELD_EVERY == 0:
             await trio.lowlevel.checkpoint()
+        if self.hooks is not None and self.hooks.each_period:
+            await self.hooks.after_period(self.periods)
+            self._raise_pending()
         return fired
 
     def _step(self, stretched: bool) -> tuple[Fired, ...]:
@@ -373,6 +347,23 @@ class TickLoop(Generic[S]):
         for key in [k for k, (_, w) in monitors.items() if w is watch]:
             self.robot.disarm(key)
             del monitors[key]
+
+    async def _preempted(
+        self,
+        script: Script,
+        block: TBlock,
+        fired: tuple[Fired, ...],
+        monitors: dict[int, tuple[int, Watch]],
+        k: int,
+        t0: float,
+        stretch: int,
+    ) -> Preempted:
+        preempted = self._preempt(script, block, fired, monitors, k, t0, stretch)
+        if self.hooks is not None:
+            cond = preempted.reaction.condition
+            await self.hooks.after_monitor(cond.event, str(cond), self.tick)
+            self._raise_pending()
+        return preempted
 
     def _preempt(
         self,

@@ -19,9 +19,8 @@ from dial.scene import load_scene_names
 def _run(path: Path, perturb: float = 0.0) -> tuple[str, list[float]]:
     """The log text without the summary's wall time (its one wall-clock field), and qpos."""
     sink = io.StringIO()
-    result = run(
-        load(path, loader=load_scene_names), RunOptions(log=sink, perturb_mm=perturb, seed=7)
-    )
+    script = load(path, loader=load_scene_names)
+    result = run(script, RunOptions(log=sink, perturb_mm=perturb, seed=7))
     *lines, last = sink.getvalue().splitlines()
     summary = json.loads(last)
     assert summary["kind"] == "summary" and summary.pop("wall_time") >= 0

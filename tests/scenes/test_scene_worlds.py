@@ -35,6 +35,7 @@ SCENES = (
     "explore_rounded",
     "lightbulb",
     "pour",
+    "reactions",
     "surface",
 )
 PAPER_PROGRAMS = {
