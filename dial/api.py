@@ -30,7 +30,7 @@ from dial.scene import load_scene_names
 from dial.scene.resolve import scene_option
 
 if TYPE_CHECKING:  # trio and MuJoCo load only to run: `import dial` and checking stay light
-    from dial.debug import Console
+    from dial.debug import Break, Console
     from dial.engine import Observer, RunResult
     from dial.engine.state import Saved
 
@@ -75,8 +75,16 @@ def writable(path: str | Path, what: str) -> Path:
         why = f"'{path}' is a directory"
     elif not folder.is_dir():
         why = f"no such directory '{folder}'"
-    elif not os.access(folder, os.W_OK) or (target.exists() and not os.access(target, os.W_OK)):
-        why = f"permission denied: '{path}'"
+    else:  # try it: permissions, read-only file systems and /proc say no only to a write
+        existed = target.exists()
+        try:
+            with open(target, "a", encoding="utf-8"):
+                pass
+        except OSError as e:
+            why = f"{e.strerror or e}: '{path}'"
+        else:
+            if not existed:
+                target.unlink()
     if why is not None:
         raise DialError(f"cannot write {what}: {why}")
     return target
@@ -124,23 +132,48 @@ def run(
 ) -> RunResult:
     """Run a script in its scene, as ``dial run`` does, and return its :class:`RunResult`.
 
-    ``script``: a checked :class:`Script` (from :func:`load`), or a path or bundled name to
-    load. ``tick`` (s) overrides ``@tick``, and ``speed`` divides it; ``perturb`` (mm) moves
-    the objects away from their believed poses in a direction drawn from ``seed``;
-    ``disturb``: ``--disturb`` SPECs (DESIGN 2.8). ``log``: a JSON Lines file (path or open
-    text file), flushed record by record; ``log_states`` adds the robot's state 25 times per
-    simulated second. ``record`` (.rrd), ``video`` (.mp4/.gif), ``rerun`` and ``viewer``
-    watch the run; ``observers`` are your own (:class:`~dial.engine.Observer`). ``progress``
-    is called after every tick with (tick, simulated s, running events).
-
-    Debugging (docs/debugging.md): ``breaks`` (``EVENT``, ``tick:N``, ``monitor``) and
-    ``step`` pause the run and read commands from ``console`` (default: the terminal, or
-    stdin line by line when it is not one); ``save_at=(N, FILE)`` writes a state file just
-    before the N-th block starts; ``resume=FILE`` goes on from one (with its tick, seed,
-    perturbation and disturbances: passing those too is an error).
-
-    A stop signal (SIGINT, SIGTERM) ends the run cleanly: ``result.summary.interrupted``.
+    ``script``: a :class:`Script` from :func:`load`, or a path or bundled name to load (with
+    ``scene``). The keywords are ``dial run``'s options, each described in docs/api.md. A
+    stop signal (SIGINT, SIGTERM) ends the run cleanly: ``result.summary.interrupted``.
     """
+    items, saved = _checked(tick, speed, seed, perturb, disturb, save_at, resume)
+    _check_watching(record, video, rerun, viewer)  # before the script: usage comes first
+    script = _script(script, scene)
+    from dial.engine import RunOptions
+    from dial.engine import run as run_engine
+
+    stops, console = _pausing(script, breaks, step, console)
+    with _log_sink(log) as sink:
+        options = RunOptions(
+            tick=tick,
+            speed=speed,
+            seed=seed,
+            perturb_mm=perturb,
+            disturb=items,
+            realtime=realtime or viewer,
+            log=sink,
+            log_states=log_states,
+            progress=progress,
+            observers=[*_watchers(record, video, rerun, viewer, script), *observers],
+            breaks=stops,
+            step=step,
+            console=console,
+            save_at=None if save_at is None else (save_at[0], Path(save_at[1])),
+            resume=saved,
+        )
+        return run_engine(script, options)
+
+
+def _checked(
+    tick: float | None,
+    speed: float,
+    seed: int,
+    perturb: float,
+    disturb: Sequence[str | Disturbance],
+    save_at: tuple[int, str | Path] | None,
+    resume: str | Path | None,
+) -> tuple[list[Disturbance], Saved | None]:
+    """The option checks that need no script: ranges, SPECs, the state files."""
     check_options(tick, speed, seed, perturb)
     if resume is not None and (tick is not None or speed != 1.0 or seed or perturb or disturb):
         raise OptionError(
@@ -155,42 +188,27 @@ def run(
         if save_at[0] < 1:
             raise OptionError(f"--save-at block:N needs N >= 1, got {save_at[0]}")
         writable(save_at[1], "the state file")
-    saved = None if resume is None else _load_state(Path(resume))
-    _check_watching(record, video, rerun, viewer)  # before the script: usage comes first
-    if isinstance(script, Script):
-        if scene is not None:
-            raise OptionError("scene= applies when loading: pass it to dial.load()")
-    else:
-        script = load(script, scene=scene)
-    from dial.debug import LineConsole, TerminalConsole, parse_break
-    from dial.engine import RunOptions
-    from dial.engine import run as run_engine
+    return items, None if resume is None else _load_state(Path(resume))
 
-    events = _event_names(script)
-    stops = [parse_break(b, events) for b in breaks]
+
+def _script(script: Script | str | Path, scene: str | None) -> Script:
+    if not isinstance(script, Script):
+        return load(script, scene=scene)
+    if scene is not None:
+        raise OptionError("scene= applies when loading: pass it to dial.load()")
+    return script
+
+
+def _pausing(
+    script: Script, breaks: Sequence[str], step: bool, console: Console | None
+) -> tuple[list[Break], Console | None]:
+    """The breakpoints, and where a paused run reads commands (a terminal, else stdin)."""
+    from dial.debug import LineConsole, TerminalConsole, parse_break
+
+    stops = [parse_break(b, _event_names(script)) for b in breaks]
     if (stops or step) and console is None:
         console = TerminalConsole() if sys.stdin.isatty() else LineConsole()
-
-    with _log_sink(log) as sink:
-        watchers = _watchers(record, video, rerun, viewer, script)
-        options = RunOptions(
-            tick=tick,
-            speed=speed,
-            seed=seed,
-            perturb_mm=perturb,
-            disturb=items,
-            realtime=realtime or viewer,
-            log=sink,
-            log_states=log_states,
-            progress=progress,
-            observers=[*watchers, *observers],
-            breaks=stops,
-            step=step,
-            console=console,
-            save_at=None if save_at is None else (save_at[0], Path(save_at[1])),
-            resume=saved,
-        )
-        return run_engine(script, options)
+    return stops, console
 
 
 def _event_names(script: Script) -> set[str]:

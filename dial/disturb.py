@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from dial.errors import DialError
+from dial.errors import OptionError
 from dial.instructions.types import CONTACT_KINDS, FINGERS
 from dial.units import UnitError, parse_quantity
 
@@ -21,8 +21,9 @@ SENSE_FORM = "sense sensor=KIND:FINGER at=T [for=D]"
 MAX_FORCE = 1000.0  # N: a push beyond it is a typo, not a test
 
 
-class DisturbanceError(DialError):
-    """A ``--disturb`` SPEC that does not parse; the message says what was expected."""
+class DisturbanceError(OptionError):
+    """A ``--disturb`` SPEC that does not parse, or names no body of the scene: a usage
+    error; the message says what was expected."""
 
 
 @dataclass(frozen=True)

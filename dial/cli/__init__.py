@@ -7,11 +7,12 @@ Exit status: 0 success, 1 a script or run error (or a failed criterion), 2 a usa
 from __future__ import annotations
 
 import argparse
+import signal
 import sys
 from collections.abc import Sequence
 
 from dial import __version__
-from dial.cli import replay, run, teach, text, tune
+from dial.cli import preview, replay, run, teach, text, tune
 from dial.errors import DialError, OptionError, ScriptError
 
 EPILOG = """\
@@ -37,10 +38,23 @@ def build_parser() -> argparse.ArgumentParser:
     text.add_parsers(sub)
     tune.add_parser(sub)
     teach.add_parsers(sub)
+    preview.add_parser(sub)
     return parser
 
 
 def main(argv: Sequence[str] | None = None) -> int:
+    """Run the command line; ``argv`` None: this process's arguments, as the ``dial``
+    program (which then also ignores stop signals while Python shuts down)."""
+    status = _main(argv)
+    if argv is None:
+        # Everything is written and said; a second Ctrl-C must not turn the exit status
+        # into death by signal while the interpreter tears MuJoCo and trio down.
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            signal.signal(sig, signal.SIG_IGN)
+    return status
+
+
+def _main(argv: Sequence[str] | None) -> int:
     args = build_parser().parse_args(argv)
     try:
         status: int = args.func(args)

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import argparse
+import os
+import sys
 
 from dial.api import load
 from dial.errors import OptionError
@@ -29,3 +31,14 @@ def scene_argument(p: argparse.ArgumentParser, checking: bool = False) -> None:
 def at_least(flag: str, value: int | None, least: int) -> None:
     if value is not None and value < least:
         raise UsageError(f"{flag} must be at least {least}, got {value}")
+
+
+def plot_usage(flag: str) -> None:
+    """A usage error (exit 2) if ``flag`` cannot draw here; offscreen EGL on headless Linux."""
+    if sys.platform.startswith("linux"):  # must precede `import mujoco`
+        os.environ.setdefault("MUJOCO_GL", "egl")
+    from dial.teach.pictures import plot_problem
+
+    problem = plot_problem(flag)
+    if problem is not None:
+        raise UsageError(problem)

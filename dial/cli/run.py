@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING
 from dial import api
 from dial.cli.common import UsageError, load_script, scene_argument
 from dial.recording.timeline import qualified_event
-from dial.scheduler.signals import EXIT_STATUS
+from dial.scheduler.signals import EXIT_STATUS, StopRequest, catch_stop_signals
 
 if TYPE_CHECKING:
     from dial.engine import RunResult
@@ -113,11 +113,22 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
 
 
 def cmd_run(args: argparse.Namespace) -> int:
+    # From here to the exit, a stop signal stops the run (which catches it first) or, once
+    # the run is over, is ignored: a second Ctrl-C cannot cut the summary or the log short.
+    stop = StopRequest()
+    with catch_stop_signals(stop):
+        return _run(args, stop)
+
+
+def _run(args: argparse.Namespace, stop: StopRequest) -> int:
     if args.log_states and not args.log:
         raise UsageError("--log-states writes into the log: give --log FILE.jsonl too")
     api.check_options(args.tick, args.speed, args.seed, args.perturb)
     save_at = _save_at(args.save_at)
     script = load_script(args.script, args.scene)
+    if stop.signal is not None:  # while the script was being checked
+        print(f"dial: interrupted by {stop.signal}", file=sys.stderr)
+        return EXIT_STATUS[stop.signal]
     result = api.run(
         script,
         tick=args.tick,

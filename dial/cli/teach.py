@@ -3,11 +3,10 @@
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 from pathlib import Path
 
-from dial.cli.common import UsageError
+from dial.cli.common import UsageError, plot_usage
 from dial.instructions.scene_names import SceneNotFoundError
 
 
@@ -62,23 +61,12 @@ def _scene(arg: str) -> str:
         raise UsageError(str(e)) from None
 
 
-def _plot_usage(flag: str) -> None:
-    """A usage error (exit 2) if ``flag`` cannot draw here; offscreen EGL on headless Linux."""
-    if sys.platform.startswith("linux"):  # must precede `import mujoco`
-        os.environ.setdefault("MUJOCO_GL", "egl")
-    from dial.teach.pictures import plot_problem
-
-    problem = plot_problem(flag)
-    if problem is not None:
-        raise UsageError(problem)
-
-
 def cmd_teach(args: argparse.Namespace) -> int:
     if args.viewer and args.snapshot:
         raise UsageError("--viewer and --snapshot: choose one (--snapshot is for no display)")
     scene = _scene(args.scene)
     if args.snapshot:
-        _plot_usage("--snapshot")
+        plot_usage("--snapshot")
     if args.viewer:
         from dial.recording.viewer import require_display
 
@@ -94,7 +82,7 @@ def cmd_world(args: argparse.Namespace) -> int:
     if args.picture:
         if Path(args.picture).suffix.lower() != ".png":
             raise UsageError(f"--picture writes a .png file, not '{args.picture}'")
-        _plot_usage("--picture")
+        plot_usage("--picture")
     from dial.teach.app import world
 
     text, frames = world(scene, Path(args.picture) if args.picture else None)

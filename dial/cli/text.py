@@ -82,8 +82,9 @@ def cmd_fmt(args: argparse.Namespace) -> int:
         try:
             text = path.read_text(encoding="utf-8")
         except UnicodeDecodeError as e:
+            line = e.object[: e.start].count(b"\n") + 1
             raise DialError(
-                f"{arg}: not UTF-8 text (byte {e.start}); dial scripts are UTF-8"
+                f"{arg}:{line}: not UTF-8 text (byte {e.start + 1}); dial scripts are UTF-8"
             ) from None
         formatted = format_text(text, str(path))
         if formatted == text:

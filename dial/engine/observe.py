@@ -17,6 +17,7 @@ from dial.backend.driver import MujocoRobot
 from dial.parser.lanes import LanePlan
 from dial.scene.world import World
 from dial.scheduler.log import EventLog
+from dial.scheduler.types import RunAborted
 
 if TYPE_CHECKING:
     from dial.engine.result import RunResult
@@ -53,15 +54,31 @@ def every(rate_hz: float, period: float) -> int:
 
 
 def fan_out(observers: list[Observer]) -> Callable[[int, int], None] | None:
-    """One callback for the runner; None (no per-period cost) without observers."""
-    if len(observers) <= 1:
-        return observers[0].period if observers else None
+    """One callback for the runner; None (no per-period cost) without observers.
+
+    An observer that fails (a video that cannot be written, a viewer gone) stops the run
+    cleanly, as an abort that names it: the log and the summary are still written.
+    """
+    if not observers:
+        return None
 
     def period(periods: int, tick: int) -> None:
         for observer in observers:
-            observer.period(periods, tick)
+            try:
+                observer.period(periods, tick)
+            except Exception as e:
+                raise RunAborted(f"{describe(observer)} failed: {first_line(e)}", None, tick) from e
 
     return period
+
+
+def describe(observer: object) -> str:
+    """What an observer is, for messages: its ``what`` if it says, else its class name."""
+    return str(getattr(observer, "what", type(observer).__name__))
+
+
+def first_line(e: BaseException) -> str:
+    return (str(e).strip().splitlines() or [type(e).__name__])[0]
 
 
 class StateLog:
@@ -73,6 +90,8 @@ class StateLog:
     (the script's event lanes), a ``lanes`` record comes first, so that a replayed recording
     draws the same lanes.
     """
+
+    what = "the state log"  # how messages name it
 
     def __init__(self, rate_hz: float = STATE_HZ, lanes: LanePlan | None = None) -> None:
         self.rate_hz, self.lanes = rate_hz, lanes

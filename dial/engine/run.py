@@ -21,7 +21,7 @@ from dial.backend.snapshot import Snapshot
 from dial.debug import Break, Console, Session
 from dial.disturb import Disturbance, parse_disturbance
 from dial.engine.debugging import session
-from dial.engine.observe import Observer, StateLog, Watched, fan_out
+from dial.engine.observe import Observer, StateLog, Watched, describe, fan_out, first_line
 from dial.engine.result import RunResult, measure_criteria
 from dial.engine.setup import prepare
 from dial.engine.state import RunSettings, Saved
@@ -30,6 +30,7 @@ from dial.parser.lanes import LanePlan
 from dial.parser.script import Script
 from dial.primitives import Context, make_factory
 from dial.scheduler.log import EventLog
+from dial.scheduler.position import Resume
 from dial.scheduler.runner import Runner
 from dial.scheduler.signals import StopRequest, catch_stop_signals
 from dial.scheduler.ticks import Progress
@@ -84,23 +85,12 @@ def run(script: Script, options: RunOptions) -> RunResult:
         settings = _settings(script, options)
         disturb = [parse_disturbance(d) for d in settings.disturb]
         robot, ctx = prepare(script, log, settings.perturb_mm, settings.seed, disturb)
-        resume = None
-        if options.resume is not None:
-            resume = options.resume.check(script)
-            options.resume.restore(robot, ctx)
-            log.write(
-                "resume",
-                file=str(options.resume.source),
-                block=resume.blocks + 1,
-                tick=resume.tick,
-                t=resume.periods * robot.period,
-            )
+        resume = _resume(script, options.resume, robot, ctx, log)
         states = [StateLog(lanes=LanePlan.from_script(script))] if options.log_states else []
-        observers = states + list(options.observers)
         begun: list[Observer] = []
         result: RunResult | None = None
         try:  # observers end also on an error: a recording keeps what was seen
-            for observer in observers:
+            for observer in states + list(options.observers):
                 observer.begin(Watched(robot, ctx.world, log))
                 begun.append(observer)
             runner = Runner(
@@ -113,16 +103,14 @@ def run(script: Script, options: RunOptions) -> RunResult:
                 pace=1.0 if options.realtime else None,
                 stop=stop,
             )
-            hooks = _debugging(script, runner, robot, ctx, stop, settings, begun, options)
-            runner.hooks = hooks
+            hooks = runner.hooks = _debugging(script, runner, ctx, stop, settings, begun, options)
             start, cpu = time.perf_counter(), time.process_time()
             summary = trio.run(runner.run, script, resume)
             wall, cpu = time.perf_counter() - start, time.process_time() - cpu
-            criteria = measure_criteria(ctx.world, robot.model, robot.data, ctx.results)
             result = RunResult(
                 summary,
                 ctx.world,
-                criteria,
+                measure_criteria(ctx.world, robot.model, robot.data, ctx.results),
                 dict(ctx.results),
                 wall,
                 cpu,
@@ -135,8 +123,25 @@ def run(script: Script, options: RunOptions) -> RunResult:
             log.write("summary", **result.as_record())
             return result
         finally:
-            for observer in begun:
-                observer.end(result)
+            _end(begun, result)
+
+
+def _resume(
+    script: Script, saved: Saved | None, robot: MujocoRobot, ctx: Context, log: EventLog
+) -> Resume | None:
+    """Put a saved state back (checking the script against it) and log the ``resume``."""
+    if saved is None:
+        return None
+    resume = saved.check(script)
+    saved.restore(robot, ctx)
+    log.write(
+        "resume",
+        file=str(saved.source),
+        block=resume.blocks + 1,
+        tick=resume.tick,
+        t=resume.periods * robot.period,
+    )
+    return resume
 
 
 def _settings(script: Script, options: RunOptions) -> RunSettings:
@@ -154,7 +159,6 @@ def _settings(script: Script, options: RunOptions) -> RunSettings:
 def _debugging(
     script: Script,
     runner: Runner[Snapshot],
-    robot: MujocoRobot,
     ctx: Context,
     stop: StopRequest,
     settings: RunSettings,
@@ -167,7 +171,6 @@ def _debugging(
     return session(
         script,
         runner,
-        robot,
         ctx,
         stop,
         settings,
@@ -177,3 +180,16 @@ def _debugging(
         options.step,
         options.save_at,
     )
+
+
+def _end(observers: list[Observer], result: RunResult | None) -> None:
+    """End every observer, whatever the others do; then say which failed (the log and the
+    summary are written by then)."""
+    failed = []
+    for observer in observers:
+        try:
+            observer.end(result)
+        except Exception as e:
+            failed.append(f"{describe(observer)} failed: {first_line(e)}")
+    if failed:
+        raise DialError("; ".join(failed))

@@ -44,6 +44,8 @@ class Recorder:
     the script and draws holds; without it lanes come in the order events first run.
     """
 
+    what = "the rerun recording"  # how messages name it
+
     def __init__(
         self,
         sink: RerunSink,

@@ -15,7 +15,7 @@ from typing import Any
 import mujoco
 
 from dial.engine import RunResult, Watched
-from dial.engine.observe import every
+from dial.engine.observe import every, first_line
 from dial.errors import DialError
 from dial.recording.geometry import Camera, task_camera
 from dial.recording.observers import object_bodies
@@ -36,10 +36,6 @@ def video_problem(path: str) -> str | None:
     if missing:
         return f"--video needs the optional 'video' extra ({', '.join(missing)}): {EXTRA}"
     return None
-
-
-def first_line(e: BaseException) -> str:
-    return (str(e).strip().splitlines() or [type(e).__name__])[0]
 
 
 class Renderer:
@@ -77,6 +73,8 @@ class Renderer:
 
 class VideoWriter:
     """Writes a frame every ``1 / fps`` s of simulated time (rounded to whole periods)."""
+
+    what = "the video writer"  # how messages name it
 
     def __init__(self, path: Path, fps: float = VIDEO_FPS) -> None:
         self.path, self.fps = path, fps

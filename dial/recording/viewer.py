@@ -12,11 +12,10 @@ import sys
 from typing import Any
 
 from dial.engine import RunResult, Watched
-from dial.engine.observe import every
+from dial.engine.observe import every, first_line
 from dial.errors import DialError
 from dial.recording.geometry import task_camera
 from dial.recording.observers import object_bodies
-from dial.recording.video import first_line
 
 VIEWER_HZ = 60.0  # screen updates per second of simulated (here also wall-clock) time
 
@@ -47,6 +46,8 @@ def _probe_glfw() -> None:
 
 
 class PassiveViewer:
+    what = "MuJoCo's viewer"  # how messages name it
+
     def begin(self, run: Watched) -> None:
         _probe_glfw()
         import mujoco.viewer

@@ -94,8 +94,8 @@ class Records:
             **self._whose(path),
         )
 
-    def happening(self, happening: Happening) -> None:
-        self.log.write(happening.kind, **happening.fields)
+    def happening(self, happening: Happening, tick: int) -> None:
+        self.log.write(happening.kind, **happening.fields, tick=tick)
 
     def error(self, event: str | None, tick: int, t: float, message: str) -> None:
         self.log.write("error", event=event, tick=tick, t=t, message=message)

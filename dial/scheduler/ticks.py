@@ -257,7 +257,7 @@ class TickLoop(Generic[S]):
 
     def _report(self, report: Report) -> tuple[Fired, ...]:
         for happening in report.happenings:
-            self.records.happening(happening)
+            self.records.happening(happening, self.tick)
         if report.fault is not None and self.abort is None:
             running = ", ".join(a.info.event.name for a in self.active if a.ended is None)
             self.abort = RunAborted(

@@ -56,7 +56,7 @@ def teach(
 
 def _attach_viewer(sim: Sim) -> Any:
     """MuJoCo's passive viewer, updated as the session steps, paced to wall-clock time."""
-    from dial.recording.video import first_line
+    from dial.engine.observe import first_line
     from dial.recording.viewer import _probe_glfw
 
     _probe_glfw()

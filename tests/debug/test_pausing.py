@@ -81,16 +81,18 @@ def test_a_scripted_session_through_stdin() -> None:
     assert "unknown command 'bogus'; commands: continue, tick, period, state" in out
 
 
-def _read_until(fd: int, marker: bytes, seen: bytearray, deadline: float) -> None:
-    while marker not in seen:
+def _read_until(fd: int, marker: bytes, seen: bytearray, start: int, deadline: float) -> int:
+    """Read until ``marker`` appears in ``seen`` after ``start``; the index just past it."""
+    while (found := seen.find(marker, start)) < 0:
         if time.monotonic() > deadline:
-            raise AssertionError(f"no {marker!r} in {bytes(seen[-500:])!r}")
+            raise AssertionError(f"no {marker!r} in {bytes(seen[start:][-500:])!r}")
         ready, _, _ = select.select([fd], [], [], 0.5)
         if ready:
             try:
                 seen += os.read(fd, 4096)
             except OSError:
-                return
+                break
+    return found + len(marker)
 
 
 def test_a_session_at_a_terminal() -> None:
@@ -100,15 +102,14 @@ def test_a_session_at_a_terminal() -> None:
     seen = bytearray()
     deadline = time.monotonic() + 600
     try:
-        _read_until(leader, b"(dial) ", seen, deadline)
+        at = _read_until(leader, b"(dial) ", seen, 0, deadline)
         assert b"--break grabpit" in seen
         os.write(leader, b"state\n")
-        _read_until(leader, b"tendon differential", seen, deadline)
-        seen.clear()
-        _read_until(leader, b"(dial) ", seen, deadline)
+        at = _read_until(leader, b"tendon differential", seen, at, deadline)
+        at = _read_until(leader, b"(dial) ", seen, at, deadline)
         os.write(leader, b"tick\n")
-        _read_until(leader, b"paused at tick 37", seen, deadline)
-        _read_until(leader, b"(dial) ", seen, deadline)
+        at = _read_until(leader, b"paused at tick 37", seen, at, deadline)
+        at = _read_until(leader, b"(dial) ", seen, at, deadline)
         os.write(leader, b"continue\n")
         assert proc.wait(timeout=600) == 0
     finally:

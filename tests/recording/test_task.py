@@ -42,7 +42,7 @@ def test_pour_plots_the_cup_contents_and_the_pitcher_tilt() -> None:
     probe, _, data, texts = _scene("pour")
     assert [s.label for s in probe.series] == ["cup contents", "pitcher tilt"]
     inside, tilt = probe.sample(data)
-    assert texts == [f"{inside:.0f}/36 in pour_cup_inside (min 50%)", f"tilt {tilt:.1f} deg"]
+    assert texts == [f"{inside:.0f}/20 in pour_cup_inside (min 50%)", f"tilt {tilt:.1f} deg"]
 
 
 def test_criteria_that_judge_a_fit_are_not_plotted() -> None:
