@@ -307,7 +307,17 @@ def _check(text: str, path: str, origin: Path, ctx: _Context) -> Script:
 
 
 def _check_file(path: Path, display: str, ctx: _Context) -> Script:
-    text = path.read_text(encoding="utf-8", errors="replace")
+    raw = path.read_bytes()
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as e:  # say where, then check the rest as well as it reads
+        text = raw.decode("utf-8", errors="replace")
+        start = raw.rfind(b"\n", 0, e.start) + 1
+        line = raw.count(b"\n", 0, e.start) + 1
+        col = len(raw[start : e.start].decode("utf-8", errors="replace")) + 1
+        source = text.split("\n")[line - 1]
+        message = f"not UTF-8 text (byte 0x{raw[e.start]:02X}); dial scripts are UTF-8"
+        ctx.diags.append(Diagnostic(display, Span.at(line, col), message, source))
     return _check(text, display, path, ctx)
 
 
