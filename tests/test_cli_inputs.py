@@ -119,3 +119,11 @@ def test_an_observer_that_fails_mid_run_stops_it_cleanly(tmp_path: Path) -> None
     assert not result.ok and result.error is not None
     assert result.error.startswith("the broken observer failed: [Errno 28] No space left")
     assert [r["kind"] for r in result.log.records[-2:]] == ["error", "summary"]
+
+
+def test_check_of_a_latin1_script(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    path = tmp_path / "latin.dial"
+    path.write_bytes("// ok\n// caf\xe9\n".encode("latin-1"))
+    assert main(["check", str(path)]) == 1
+    out = capsys.readouterr().out
+    assert out.startswith(f"{path}:2:7: not UTF-8 text (byte 0xE9); dial scripts are UTF-8\n")

@@ -7,7 +7,7 @@ from pathlib import Path
 import pytest
 
 from dial.errors import ScriptError, Span
-from dial.parser import TBlock, TCall, TIf, TRepeat, check_text, parse
+from dial.parser import TBlock, TCall, TIf, TRepeat, check_text, parse, parse_partial
 from dial.parser.ast import Block, Condition
 from dial.parser.script import TAbort, TOn, TResume, TRetry, Watch
 
@@ -142,3 +142,16 @@ def test_an_on_may_follow_a_broken_block_without_a_second_error() -> None:
     with pytest.raises(ScriptError) as info:
         check_text(text, "w.dial")
     assert [d.span.line for d in info.value.diagnostics] == [5]
+    # A broken block inside the first reaction does not make the second one an error.
+    text = WATCH_HEAD + "down  #=x\ntouch ~~~\n@on touch\nup #x\n@end\n@on !touch\n@end\n"
+    with pytest.raises(ScriptError) as info:
+        check_text(text, "w.dial")
+    assert [d.span.line for d in info.value.diagnostics] == [5, 8]
+
+
+def test_a_block_after_a_broken_one_is_still_read() -> None:
+    with pytest.raises(ScriptError) as info:
+        check_text(HEAD + "go #x\n\ngo #\nopen #\n\nopen #\n", "t")
+    assert [d.span.line for d in info.value.diagnostics] == [3]
+    program, _ = parse_partial(HEAD + "go #x\n\ngo #\n// c\nopen #\n\nopen #\n")
+    assert [len(b.lines) for b in program.body if isinstance(b, Block)] == [2, 1]

@@ -16,7 +16,6 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from dial.backend.snapshot import FloatArray
 from dial.disturb import Disturbance, DisturbanceError, Dropout, Push
 from dial.scheduler.types import Happening
 
@@ -104,22 +103,6 @@ class Disturbances:
                     force += w.item.force
             data.xfrc_applied[body, :3] = force
         self._set_dropped()
-
-    def _dropouts(self) -> list[Dropout]:
-        return [w.item for w in self._active if isinstance(w.item, Dropout)]
-
-    def mask(
-        self, tactile: FloatArray, differentials: FloatArray, q: FloatArray, target: FloatArray
-    ) -> None:
-        """Mask a snapshot's fresh arrays in place: (4, 256) depths, (16,) N, (16,) rad."""
-        for d in self._dropouts():
-            joints = slice(4 * d.finger, 4 * d.finger + 4)
-            if d.sensor == "tactile":
-                tactile[d.finger] = 0.0
-            elif d.sensor == "force":
-                differentials[joints] = 0.0
-            else:
-                q[joints] = target[joints]
 
 
 def _record(w: _Window, phase: str, t: float, step: int) -> Happening:

@@ -4,6 +4,8 @@ tendons held at their tension limit (a warning, not a fault)."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import mujoco
 import numpy as np
 
@@ -32,24 +34,27 @@ class Safety:
         self._arm_lo = arm_range[:, 0] - LIMIT_SLACK
         self._arm_hi = arm_range[:, 1] + LIMIT_SLACK
         self._pinned_at = index.tension_limit - 1e-6
+        # Views where the addresses run in order (a read through them copies nothing).
+        self._arm_q = _view(data.qpos, index.arm_qpos)
+        self._tensions = _view(data.sensordata, index.tension_sensors)
         self.saturated_since = np.full(32, -1.0)
         self.saturation_logged = np.zeros(32, dtype=bool)
 
     def check(self, time: float, happened: list[Happening]) -> str | None:
         """A fault message, or None; appends a ``warning`` for a tendon held at its limit."""
-        d, ix = self.data, self.index
+        ix = self.index
         # MuJoCo resets the state itself when it meets a bad qacc/qpos/qvel, and counts a
         # warning: a nonzero count is the divergence (the state is no longer the run's).
         for warning in self._divergence:
             if warning.number:
                 return "the physics diverged (MuJoCo reset an unstable state)"
-        q = d.qpos[ix.arm_qpos]
-        if ((q < self._arm_lo) | (q > self._arm_hi)).any():
+        q = self._arm_q()
+        if (q < self._arm_lo).any() or (q > self._arm_hi).any():
             j = int(np.flatnonzero((q < self._arm_lo) | (q > self._arm_hi))[0])
             return f"PUMA joint {j + 1} is beyond its limit ({np.degrees(q[j]):.1f} deg)"
         # A tendon pinned at its limit is not a fault (a fist pressed into the palm does it),
         # but a researcher should know: log it once per episode.
-        pinned = d.sensordata[ix.tension_sensors] >= self._pinned_at
+        pinned = self._tensions() >= self._pinned_at
         if not pinned.any() and not self.saturation_logged.any():
             self.saturated_since.fill(-1.0)
             return None
@@ -66,3 +71,12 @@ class Safety:
             happened.append(Happening("warning", {"t": time, "message": message}))
         self.saturation_logged = held | (self.saturation_logged & pinned)
         return None
+
+
+def _view(array: np.ndarray, index: np.ndarray) -> Callable[[], np.ndarray]:
+    """A reader of ``array[index]``: a view when ``index`` runs in order, else a copy."""
+    first = int(index[0])
+    if np.array_equal(index, np.arange(first, first + len(index))):
+        view = array[first : first + len(index)]
+        return lambda: view
+    return lambda: array[index]

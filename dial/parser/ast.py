@@ -7,7 +7,7 @@ program written with different spacing (``parse(fmt(x)) == parse(x)``).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Literal
+from typing import Literal, NamedTuple
 
 from dial.errors import Span
 
@@ -55,27 +55,24 @@ class Definition:
     broken: bool = field(default=False, compare=False)  # its parameters did not tokenize
 
 
-@dataclass(frozen=True, slots=True)
-class RunMark:
+class RunMark(NamedTuple):
     """One run drawn on an execution line, in block ticks (1-based, inclusive).
 
     ``exec_end`` is the last ``#``/``=`` tick and ``hold_end`` the last tick
-    including ``-`` (equal to ``exec_end`` when there is no hold).
+    including ``-`` (equal to ``exec_end`` when there is no hold). Its place in the
+    text is :meth:`ExecLine.span_of`.
     """
 
     start: int
     exec_end: int
     hold_end: int
-    span: Span = field(default=_NOSPAN, compare=False)
 
 
-@dataclass(frozen=True, slots=True)
-class WatchMark:
+class WatchMark(NamedTuple):
     """A watched span ``~~~`` on an execution line, in block ticks (1-based, inclusive)."""
 
     start: int
     end: int
-    span: Span = field(default=_NOSPAN, compare=False)
 
 
 @dataclass(frozen=True, slots=True)
@@ -87,6 +84,11 @@ class ExecLine:
     last_tick: int  # rightmost non-space diagram tick, counting '.' and '~'
     line: int = field(default=0, compare=False)
     watches: tuple[WatchMark, ...] = ()
+    column: int = field(default=1, compare=False)  # the text column of the block's tick 1
+
+    def span_of(self, first: int, last: int) -> Span:
+        """Where block ticks ``first..last`` are drawn on this line."""
+        return Span(self.line, first + self.column - 1, last + self.column)
 
     @property
     def event_span(self) -> Span:

@@ -21,9 +21,13 @@ from dial.instructions.scene_names import SceneLoader, SceneNames, SceneNotFound
 from dial.instructions.types import EFFECTORS, Name
 from dial.parser.ast import Call, Condition, Definition, ExecLine, Program
 from dial.parser.bind import bind
-from dial.parser.compile import WATCHABLE, compile_body, diagram_events
+from dial.parser.compile import compile_body, diagram_events
 from dial.parser.parse import parse_partial
 from dial.parser.script import EventDef, Script
+
+# The instructions whose condition holds or not at each moment, so that a monitor can sense
+# it every control period: the contact conditions (DESIGN 2.7).
+WATCHABLE = tuple(name for name, i in INSTRUCTIONS.items() if i.condition is not None)
 
 
 def _hint(name: str, valid: list[str]) -> str:
@@ -70,7 +74,8 @@ class _Checker:
         self.program = program
         self.ctx = ctx
         self.origin = origin  # the real file, for resolving @call and @scene paths
-        self.lines = source.split("\n")
+        self.source = source
+        self.lines: list[str] | None = None  # split on the first problem: most checks have none
         self.events: dict[str, EventDef] = {}
         self.broken: set[str] = set()  # defined, but the definition has errors
         self.shown: set[str] = set()  # events that appear in a diagram
@@ -78,6 +83,8 @@ class _Checker:
         self.scene_failed = False
 
     def error(self, span: Span, message: str) -> None:
+        if self.lines is None:
+            self.lines = self.source.split("\n")
         text = self.lines[span.line - 1] if 0 < span.line <= len(self.lines) else ""
         self.ctx.diags.append(Diagnostic(self.program.path, span, message, text))
 
@@ -215,14 +222,14 @@ class _Checker:
         if event.effectors or not instr.sensing:
             what = ", ".join(e for e in EFFECTORS if e in event.effectors) or "an effector"
             self.error(
-                line.watches[0].span,
+                line.span_of(*line.watches[0]),
                 f"event '{line.event}' cannot be watched: '~' marks a sensing event, and "
                 f"'{line.event}' ({instr.name}) commands {what}",
             )
             return False
-        if instr.name not in WATCHABLE:
+        if instr.condition is None:
             self.error(
-                line.watches[0].span,
+                line.span_of(*line.watches[0]),
                 f"event '{line.event}' ({instr.name}) cannot be watched: only "
                 f"{', '.join(WATCHABLE[:-1])} and {WATCHABLE[-1]} can, because only a contact "
                 "condition holds or not at each moment",
@@ -300,19 +307,36 @@ def _check(text: str, path: str, origin: Path, ctx: _Context) -> Script:
 
 
 def _check_file(path: Path, display: str, ctx: _Context) -> Script:
-    text = path.read_text(encoding="utf-8", errors="replace")
+    raw = path.read_bytes()
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as e:  # say where, then check the rest as well as it reads
+        text = raw.decode("utf-8", errors="replace")
+        start = raw.rfind(b"\n", 0, e.start) + 1
+        line = raw.count(b"\n", 0, e.start) + 1
+        col = len(raw[start : e.start].decode("utf-8", errors="replace")) + 1
+        source = text.split("\n")[line - 1]
+        message = f"not UTF-8 text (byte 0x{raw[e.start]:02X}); dial scripts are UTF-8"
+        ctx.diags.append(Diagnostic(display, Span.at(line, col), message, source))
     return _check(text, display, path, ctx)
 
 
 @contextmanager
 def _no_gc() -> Iterator[None]:
     """Pause the cyclic garbage collector: a script's tree holds no cycles, and on a large
-    script its full collections would make the check's cost grow faster than its size."""
+    script its collections would make the check's cost grow faster than its size.
+
+    Afterwards, freezing and at once unfreezing moves what the check made into the oldest
+    generation without a pass over it (a young-generation pass over a large script's tree
+    costs a fifth of its check); it stays collectable there, as any long-lived data.
+    """
     enabled = gc.isenabled()
     gc.disable()
     try:
         yield
     finally:
+        gc.freeze()
+        gc.unfreeze()
         if enabled:
             gc.enable()
 

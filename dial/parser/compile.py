@@ -40,9 +40,6 @@ from dial.parser.script import (
     Watch,
 )
 
-# The instructions whose condition holds or not at each moment, so that a monitor can
-# sense it every control period: the contact conditions.
-WATCHABLE = ("position_contact", "force_contact", "tactile_contact")
 _START_LINE = attrgetter("start", "line")
 
 
@@ -116,15 +113,21 @@ def compile_block(block: Block, checks: Checks) -> TBlock:
         if event is None:
             continue
         if line.watches and checks.watched(line):
-            watches += (Watch(line.event, line.line, w.start, w.end, w.span) for w in line.watches)
-        name, number, effectors = line.event, line.line, event.effectors
+            watches += (
+                Watch(line.event, line.line, w.start, w.end, line.span_of(w.start, w.end))
+                for w in line.watches
+            )
+        name, number, effectors, col = line.event, line.line, event.effectors, line.column
         runs += [
-            Run(name, number, m.start, m.exec_end, m.hold_end, effectors, m.span) for m in line.runs
+            Run(name, number, s, e, h, effectors, Span(number, s + col - 1, h + col))
+            for s, e, h in line.runs
         ]
-    runs.sort(key=_START_LINE)
-    conflicts(runs, checks)
-    watches.sort(key=_START_LINE)
-    overlapping_watches(watches, checks)
+    if len(runs) > 1:
+        runs.sort(key=_START_LINE)
+        conflicts(runs, checks)
+    if len(watches) > 1:
+        watches.sort(key=_START_LINE)
+        overlapping_watches(watches, checks)
     reactions = tuple(
         TOn(r.condition, compile_body(r.body, checks), r.line) for r in block.reactions
     )

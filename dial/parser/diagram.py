@@ -9,8 +9,9 @@ from typing import NamedTuple
 # any other single character (an error).
 _TOKEN = re.compile(r"(#=*-*)|(~+)|([ .]+)|(.)")
 # Diagrams without a problem, read without a Python loop over their tokens.
-_RUNS = re.compile(r"(?:#=*-*|[ .]+)*")
-_WATCHES = re.compile(r"[~ .]*")
+# Possessive quantifiers: a diagram that does not match fails at once, never backtracking.
+_RUNS = re.compile(r"(?:#=*+-*+|[ .])*+")
+_WATCHES = re.compile(r"[~ .]*+")
 _RUN = re.compile(r"#(=*)(-*)")
 _WATCH = re.compile(r"~+")
 

@@ -109,7 +109,7 @@ def abort_message(error: Report, span: Span, params: list[Param]) -> str | None:
 
 
 MAX_NAME_BYTES = 255  # one file or directory name, as file systems allow
-MAX_PATH_CHARS = 1024
+MAX_PATH_BYTES = 1024
 
 
 def file_path(error: Report, word: Word, what: str) -> bool:
@@ -124,8 +124,8 @@ def file_path(error: Report, word: Word, what: str) -> bool:
             f"{what} holds the control character {code}",
         )
         return False
-    if len(text) > MAX_PATH_CHARS:
-        error(word.span, f"{what} is {len(text)} characters long; at most {MAX_PATH_CHARS}")
+    if len(text.encode()) > MAX_PATH_BYTES:
+        error(word.span, f"{what} is {len(text.encode())} bytes long; at most {MAX_PATH_BYTES}")
         return False
     long = next((p for p in text.split("/") if len(p.encode()) > MAX_NAME_BYTES), None)
     if long is not None:

@@ -10,7 +10,7 @@ from difflib import get_close_matches
 from functools import lru_cache
 from typing import NamedTuple
 
-from dial.errors import Diagnostic, ScriptError, Span
+from dial.errors import Diagnostic, ScriptError, Span, shorten
 from dial.parser import directives as args
 from dial.parser.ast import (
     Block,
@@ -27,7 +27,7 @@ from dial.parser.ast import (
 from dial.parser.diagram import Diagram, read_diagram
 from dial.parser.source import Kind, Line, scan
 from dial.parser.structure import Structure
-from dial.parser.words import WordError, tokenize
+from dial.parser.words import WordError, bare_words, tokenize
 from dial.units import UnitError, parse_quantity
 
 NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
@@ -53,8 +53,12 @@ class _Problem(NamedTuple):
     message: str
 
 
-@lru_cache(maxsize=4096)
 def _read_execution(code: str) -> tuple[str, int, int, Diagram] | _Problem:
+    # Long lines are rare and costly to keep: only short ones are cached.
+    return _read_short(code) if len(code) <= 400 else _read_line(code)
+
+
+def _read_line(code: str) -> tuple[str, int, int, Diagram] | _Problem:
     """An execution line (comments blanked, right-stripped): its event, the first and last
     diagram columns and the marks; or its first problem.
 
@@ -86,11 +90,13 @@ def _read_execution(code: str) -> tuple[str, int, int, Diagram] | _Problem:
     return event, first, len(code) - 1, marks
 
 
+_read_short = lru_cache(maxsize=4096)(_read_line)
+
+
 class _Parser:
     def __init__(self, text: str, path: str, depth: int = 0) -> None:
         self.path = path
         self.lines, problems = scan(text)
-        self.by_number = {ln.number: ln for ln in self.lines}
         self.diags: list[Diagnostic] = []
         for span, message in problems:
             self.error(span, message)
@@ -103,7 +109,7 @@ class _Parser:
         self.tick_value: float | None = None
 
     def error(self, span: Span, message: str) -> None:
-        ln = self.by_number.get(span.line)
+        ln = self.lines[span.line - 1] if 0 < span.line <= len(self.lines) else None  # numbered 1..
         self.diags.append(Diagnostic(self.path, span, message, ln.text if ln else ""))
 
     # -- driver ---------------------------------------------------------------------------
@@ -116,7 +122,7 @@ class _Parser:
                 continue
             if kind is comment:
                 continue
-            if self.block:
+            if self.block or not self.block_ok:
                 self.flush()
             if kind is Kind.DEFINITION:
                 self.definition(ln)
@@ -126,6 +132,9 @@ class _Parser:
                 self.other(ln)
         self.flush()
         body = self.structure.finish()
+        # The structure reports through this parser: drop it, so that no reference cycle
+        # keeps the lines alive until a garbage collection.
+        del self.structure
         return Program(
             self.path,
             self.scene,
@@ -218,33 +227,23 @@ class _Parser:
     def flush(self) -> None:
         pending, ok = self.block, self.block_ok
         self.block, self.block_ok = [], True
-        if not pending:
-            return
         if not ok:
             self.structure.drop_block()
             return
+        if not pending:
+            return
         base = min([p.first_col for p in pending])
+        self.structure.watching = self.structure.watching or any(p.marks.watches for p in pending)
         lines = tuple([self.exec_line(p, base) for p in pending])
         length = max(x.last_tick for x in lines)
         self.structure.add(Block(lines, length, pending[0].number), lines[0].event_span)
 
     @staticmethod
     def exec_line(p: _PendingLine, base: int) -> ExecLine:
-        number = p.number
         shift = 1 - base
-        runs = tuple(
-            [
-                RunMark(s + shift, e + shift, h + shift, Span(number, s + 1, h + 2))
-                for s, e, h in p.marks.runs
-            ]
-        )
-        watches = tuple(
-            [
-                WatchMark(s + shift, e + shift, Span(number, s + 1, e + 2))
-                for s, e in p.marks.watches
-            ]
-        )
-        return ExecLine(p.event, runs, p.last_col - base + 1, number, watches)
+        runs = tuple([RunMark(s + shift, e + shift, h + shift) for s, e, h in p.marks.runs])
+        watches = tuple([WatchMark(s + shift, e + shift) for s, e in p.marks.watches])
+        return ExecLine(p.event, runs, p.last_col + shift, p.number, watches, base + 1)
 
     # -- directives -----------------------------------------------------------------------
     def directive(self, ln: Line) -> None:
@@ -259,22 +258,11 @@ class _Parser:
             valid = ", ".join("@" + d for d in DIRECTIVES)
             self.error(
                 Span(ln.number, 1, max(end, 2) + 1),
-                f"unknown directive '{code.split()[0]}'{hint} (valid: {valid})",
+                f"unknown directive '{shorten(code.split()[0])}'{hint} (valid: {valid})",
             )
             return
-        params: list[Param] | None = None
-        words: list[Word] | None = None
-        try:
-            params = tokenize(ln.number, code, end)
-            keyed = next((p for p in params if p.key is not None), None)
-            if keyed is not None:
-                self.error(keyed.span, f"unexpected '{keyed.key}=' in '@{name}'")
-                params = None
-            else:
-                words = [w for p in params for w in p.words]
-        except WordError as e:
-            if not e.known:
-                self.error(e.span, e.message)
+        read = self.arguments(ln.number, code, end, name)
+        params, words = read if read is not None else (None, None)
         # Block structure is kept even when the arguments are bad, so that one
         # mistake does not also unbalance every '@end' after it.
         if name in ("repeat", "if", "on"):
@@ -302,7 +290,27 @@ class _Parser:
                 level = self.structure.level
                 self.structure.add(Call(words[0].text, ln.number, words[0].span, level), span)
         elif name in ("resume", "retry", "abort"):
-            self.structure.ending(name, span, params, ln.number)
+            self.structure.ending(name, span, params, words, ln.number)
+
+    def arguments(
+        self, number: int, code: str, end: int, name: str
+    ) -> tuple[list[Param], list[Word]] | None:
+        """A directive's parameters and their words, or None if they are malformed."""
+        words = bare_words(number, code, end)
+        if words is not None:  # no quotes, no key=value: as most directives are
+            params = [Param(None, (w,), False, w.span) for w in words] if name == "abort" else []
+            return params, words
+        try:
+            params = tokenize(number, code, end)
+        except WordError as e:
+            if not e.known:
+                self.error(e.span, e.message)
+            return None
+        keyed = next((p for p in params if p.key is not None), None)
+        if keyed is not None:
+            self.error(keyed.span, f"unexpected '{keyed.key}=' in '@{name}'")
+            return None
+        return params, [w for p in params for w in p.words]
 
     def _top_level(self, span: Span, name: str) -> bool:
         if self.structure.nested:

@@ -74,10 +74,11 @@ def render(script: Script, layout: Layout | None = None) -> str:
         watched[w.watch.event].append(w)
     for name in names:
         out.append(name.ljust(width) + _lane(runs[name], watched[name], layout.length))
-    out += ["", "sections:"]
+    out += ["", "sections (#N: the block's number for --save-at block:N; #?: up to the run):"]
     span_w = max([len(_where(s)) for s in layout.sections] + [5])
     for s in layout.sections:
-        out.append(f"  {_where(s):<{span_w}}  {s.label}  ({s.path}:{s.line})")
+        number = "" if s.first > s.last else f"#{s.block}" if s.block is not None else "#?"
+        out.append(f"  {_where(s):<{span_w}}  {number:>5}  {s.label}  ({s.path}:{s.line})")
     out += ["", "runs:"]
     ev_w = max([len(n) for n in names] + [5])
     for p in layout.runs:

@@ -42,6 +42,9 @@ class Line(NamedTuple):
     foreign: bool
 
 
+_BY_FIRST = {"%": Kind.DEFINITION, "@": Kind.DIRECTIVE} | dict.fromkeys(_NAME_START, Kind.EXECUTION)
+
+
 def _kind(stripped: str, has_comment: bool) -> Kind:
     if not stripped:
         return Kind.COMMENT if has_comment else Kind.BLANK
@@ -118,7 +121,7 @@ def scan(text: str) -> tuple[list[Line], list[tuple[Span, str]]]:
         raw = raw.removesuffix("\r")
         if masker.open is None and "/" not in raw and ('"' not in raw or raw.count('"') % 2 == 0):
             # No comment: most lines. An even number of quotes closes every string.
-            kind = _kind(raw.rstrip(), False)
+            kind = _BY_FIRST.get(raw[:1]) or (Kind.OTHER if raw.strip() else Kind.BLANK)
             lines.append(Line(number, raw, raw, kind, False, None, False))
         else:
             lines.append(masker.mask(number, raw))

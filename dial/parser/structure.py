@@ -46,6 +46,15 @@ class _Frame:
     condition: Condition | None = None  # of '@if'; of '@on' only when it attaches to a block
     line: int = 0
     too_deep: bool = False  # beyond MAX_NESTING: reported, and dropped with what it holds
+    # Per statement list (False: ``statements``, True: ``then``), how long it was when a
+    # block with errors was left out of it: an '@on' right after that block is not also
+    # reported as following no block.
+    dropped: dict[bool, int] = field(default_factory=dict)
+
+    @property
+    def in_then(self) -> bool:
+        return self.kind == "if" and not self.in_else
+
     lost: bool = False  # a nested directive of it was dropped (its problem is reported)
 
 
@@ -56,10 +65,8 @@ class Structure:
         self.error = error
         self.base = depth  # the nesting level of the '@call' that runs this script
         self.stack: list[_Frame] = [_Frame("top", Span(1, 1, 2))]
-        # The statement list a broken block was dropped from, and its length then: an '@on'
-        # right after it is not also reported as following no block.
-        self.dropped: tuple[list[Statement], int] | None = None
         self.lenient: set[int] = set()  # blocks whose '@on' headers were broken
+        self.watching = False  # some block watches an event: its '@on' must be checked
 
     @property
     def nested(self) -> bool:
@@ -67,7 +74,7 @@ class Structure:
 
     def statements(self) -> list[Statement]:
         frame = self.stack[-1]
-        return frame.statements if frame.kind != "if" or frame.in_else else frame.then
+        return frame.then if frame.in_then else frame.statements
 
     def add(self, stmt: Statement, span: Span) -> None:
         """Append ``stmt`` (which starts at ``span``) to the current list, if reachable."""
@@ -76,7 +83,8 @@ class Structure:
 
     def drop_block(self) -> None:
         """A block with errors is left out; remember where, for a following ``@on``."""
-        self.dropped = (self.statements(), len(self.statements()))
+        frame = self.stack[-1]
+        frame.dropped[frame.in_then] = len(self.statements())
 
     def reachable(self, span: Span) -> bool:
         """False, reported, if a reaction ending precedes ``span`` in its statement list."""
@@ -97,7 +105,8 @@ class Structure:
             frame = self.stack.pop()
             self.error(frame.span, f"'@{frame.kind}' is never closed: add '@end'")
         body = tuple(self.stack[0].statements)
-        self.unhandled_watches(body)
+        if self.watching:
+            self.unhandled_watches(body)
         return body
 
     def unhandled_watches(self, body: tuple[Statement, ...]) -> None:
@@ -108,7 +117,7 @@ class Structure:
                 for ln in stmt.lines if stmt.line not in self.lenient else ():
                     for w in ln.watches if ln.event not in handled else ():
                         self.error(
-                            w.span,
+                            ln.span_of(*w),
                             f"event '{ln.event}' is watched here, but no '@on {ln.event}' or "
                             f"'@on !{ln.event}' follows the block: add one, or remove the '~'",
                         )
@@ -164,8 +173,8 @@ class Structure:
         stmts = self.statements()
         block = stmts[-1] if stmts and isinstance(stmts[-1], Block) else None
         if block is None:
-            dropped = self.dropped
-            if dropped is None or dropped[0] is not stmts or dropped[1] != len(stmts):
+            frame = self.stack[-1]
+            if frame.dropped.get(frame.in_then) != len(stmts):
                 self.error(span, "'@on' must come directly after the block it watches")
             return None
         if cond is not None and cond.event not in block.watched:
@@ -185,9 +194,10 @@ class Structure:
             self.lenient.add(block.line)
         return cond
 
-    def ending(self, name: str, span: Span, params: list[Param], number: int) -> None:
+    def ending(
+        self, name: str, span: Span, params: list[Param], words: list[Word], number: int
+    ) -> None:
         """``@resume``, ``@retry [max N]``, ``@abort "MESSAGE"``."""
-        words = [w for p in params for w in p.words]
         stmt: Ending | None = None
         if name == "resume":
             if args.arity(self.error, span, name, words, 0, "no arguments"):

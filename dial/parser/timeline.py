@@ -33,6 +33,9 @@ class Section:
     label: str
     path: str
     line: int
+    # A block's number as the run counts blocks (``--save-at block:N``), where the order is
+    # fixed: up to the first @if, loop with a condition, or reaction; else None.
+    block: int | None = None
 
 
 @dataclass(frozen=True)
@@ -165,6 +168,7 @@ class _Walk:
         self.lanes: dict[str, None] = {}
         self.compact = compact
         self.cut = False
+        self.number: int | None = 0  # blocks so far, while their order is fixed
 
     def full(self, offset: int) -> bool:
         """Whether a compact layout has reached its limits (then it stops)."""
@@ -181,6 +185,8 @@ class _Walk:
             if isinstance(step, TBlock):
                 offset = self.block(step, offset, path, label, prefix)
             elif isinstance(step, TRepeat):
+                if step.kind != "count" or self.compact:
+                    self.number = None  # how often it runs is up to the run
                 if step.kind == "count" and self.compact:
                     tag = f"{prefix}@repeat {step.count} (drawn once of {step.count})"
                     offset = self.steps(step.body, offset, path, tag)
@@ -192,6 +198,7 @@ class _Walk:
                     tag = f"{prefix}@repeat {step.kind} {step.condition} (loop, max {step.count})"
                     offset = self.steps(step.body, offset, path, tag)
             elif isinstance(step, TIf):
+                self.number = None  # which branch runs is up to the run
                 then_end = self.steps(step.then, offset, path, f"{prefix}@if {step.condition}")
                 orelse = f"{prefix}@else ({step.condition})"
                 offset = max(then_end, self.steps(step.orelse, offset, path, orelse))
@@ -211,7 +218,12 @@ class _Walk:
         self.lanes.update(dict.fromkeys(r.event for r in step.runs))
         self.lanes.update(dict.fromkeys(w.event for w in step.watches))
         end = offset + step.length
-        self.sections.append(Section(offset + 1, end, label or "block", path, step.line))
+        if self.number is not None:
+            self.number += 1
+        section = Section(offset + 1, end, label or "block", path, step.line, self.number)
+        self.sections.append(section)
+        if step.reactions:
+            self.number = None  # whether a reaction runs is up to the run
         after = end
         for r in step.reactions:
             tag = f"{prefix}@on {r.condition} (block line {step.line})"

@@ -6,6 +6,7 @@ Bundled world files are ``<models_dir>/utah_hand_puma/worlds/<name>.toml``.
 
 from __future__ import annotations
 
+from contextlib import suppress
 from pathlib import Path
 
 from dial.instructions.scene_names import SceneNotFoundError
@@ -37,7 +38,9 @@ def resolve_scene(scene: str, base_dir: Path) -> Path:
     An existing file (absolute, or relative to ``base_dir``) wins; otherwise ``scene`` must be
     a bundled scene name. Raises :class:`SceneNotFoundError` listing the bundled names.
     """
-    candidate = Path(scene).expanduser()
+    candidate = Path(scene)
+    with suppress(RuntimeError):  # '~user' of no such user: not a path; perhaps a bundled name
+        candidate = candidate.expanduser()
     if not candidate.is_absolute():
         candidate = base_dir / candidate
     if candidate.is_file():

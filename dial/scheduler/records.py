@@ -69,7 +69,11 @@ class Records:
 
     def block(self, path: str, number: int, line: int, tick: int, t: float) -> None:
         """The ``number``-th block the run starts (``--save-at block:N`` counts the same)."""
-        self.log.write("block", number=number, line=line, tick=tick, t=t, **self._whose(path))
+        record: Record = {"kind": "block", "number": number, "line": line, "tick": tick}
+        record["t"] = round(t, DIGITS) + 0.0
+        if path != self.root:
+            record["script"] = path
+        self.log.append(record)
 
     def condition(self, path: str, cond: Condition, value: bool, tick: int, t: float) -> None:
         self.log.write(

@@ -115,3 +115,14 @@ def test_a_session_at_a_terminal() -> None:
     finally:
         proc.kill()
         os.close(leader)
+
+
+def test_show_numbers_blocks_as_the_run_counts_them() -> None:
+    from dial.parser.timeline import expand
+    from dial.testing import run_fake
+
+    text = TEXT + "@repeat 3\na #\n\nb #=\n@end\na #=\n"
+    script = check_text(text, "fake.dial")
+    shown = [(s.block, s.line) for s in expand(script).sections if s.block is not None]
+    ran = [(r["number"], r["line"]) for r in run_fake(script).log.of("block")]
+    assert shown == ran and len(ran) == 8
