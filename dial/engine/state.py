@@ -146,6 +146,7 @@ def save(
         "counts": dict(loop.counts),
         "contacts": ctx.point_sets,
         "results": ctx.results,
+        "believed": {body: _array(pos) for body, (pos, _) in ctx.believed.items()},
         "robot": {
             "steps": robot.steps,
             "arm_target": _array(robot.arm_target),
@@ -245,6 +246,9 @@ class Saved:
         robot.disturbances.resume_at(robot.steps)
         ctx.point_sets.update(d["contacts"])
         ctx.results.update(d["results"])
+        for body, pos in d.get("believed", {}).items():  # as `locate` left them
+            if body in ctx.believed:
+                ctx.believed[body] = (_floats(pos, 3, f"believed {body}"), ctx.believed[body][1])
 
 
 def load(source: Path) -> Saved:
