@@ -24,7 +24,7 @@ def dial(*args: str) -> subprocess.CompletedProcess[str]:
 def test_pour_passes(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["preview", "pour.dial"]) == 0
     out = capsys.readouterr().out
-    assert out == "pour.dial: preview OK: 1 block, 13 arm targets, 6 hand targets\n"
+    assert out == "pour.dial: preview OK: 15 blocks, 21 arm targets, 6 hand targets (2 @on reactions, 7 loops once each)\n"
 
 
 def test_a_location_moved_out_of_reach_fails_naming_it_and_its_line(

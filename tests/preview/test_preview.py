@@ -69,7 +69,7 @@ def edge(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, list[str], lis
 def test_pour_previews_clean() -> None:
     result = preview(load("pour.dial"))
     assert result.ok and result.problems == [] and result.notes == []
-    assert result.summary() == "pour.dial: preview OK: 1 block, 13 arm targets, 6 hand targets"
+    assert result.summary() == "pour.dial: preview OK: 15 blocks, 21 arm targets, 6 hand targets (2 @on reactions, 7 loops once each)"
 
 
 def test_a_location_out_of_reach_is_named_at_the_line_that_uses_it(tmp_path: Path) -> None:
