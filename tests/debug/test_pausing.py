@@ -73,11 +73,11 @@ def test_a_scripted_session_through_stdin() -> None:
     done = subprocess.run(POUR, input=commands, capture_output=True, text=True, timeout=600)
     assert done.returncode == 0, done.stderr
     out = done.stdout
-    assert "paused at tick 36, t = 8.750 s: --break grabpit (line 38)" in out
-    assert "(dial) state\ntick 36, t = 8.750 s" in out
+    assert "paused at tick 57, t = 15.070 s: --break grabpit (line 136)" in out
+    assert "(dial) state\ntick 57, t = 15.070 s" in out
     for part in ("running:", "latest outcomes:", "tool: x", "thumb", "no contact"):
         assert part in out, part
-    assert "(dial) tick\npaused at tick 37" in out
+    assert "(dial) tick\npaused at tick 58" in out
     assert "unknown command 'bogus'; commands: continue, tick, period, state" in out
 
 
@@ -108,7 +108,7 @@ def test_a_session_at_a_terminal() -> None:
         at = _read_until(leader, b"tendon differential", seen, at, deadline)
         at = _read_until(leader, b"(dial) ", seen, at, deadline)
         os.write(leader, b"tick\n")
-        at = _read_until(leader, b"paused at tick 37", seen, at, deadline)
+        at = _read_until(leader, b"paused at tick 58", seen, at, deadline)
         at = _read_until(leader, b"(dial) ", seen, at, deadline)
         os.write(leader, b"continue\n")
         assert proc.wait(timeout=600) == 0
