@@ -41,10 +41,10 @@ def test_pour_finds_the_lid_by_touch_when_20mm_off(seed: int) -> None:
     (found,) = _ended(result, "found")
     assert found["data"]["objects"] == ["lid", "pitcher"]
     (scene,) = result.log.of("scene")
-    # The believed lid and pitcher moved to within 4 mm of where they truly are (the lid's plug
-    # has 3 mm of play on the pitcher, and the first feel may touch the knob off its equator).
+    # The believed lid and pitcher moved to within 1 mm of where they truly are (0.2-0.6 mm
+    # measured; in seed 1 the first feel touches the knob with the index, a side finger).
     shift = np.array(found["data"]["shift"][:2])
-    assert np.linalg.norm(shift - np.array(scene["perturb"][:2])) < 0.004
+    assert np.linalg.norm(shift - np.array(scene["perturb"][:2])) < 0.001
     assert not result.log.of("monitor")  # the way down beside the pitcher touched nothing
 
 
