@@ -3,7 +3,6 @@ final state are the uninterrupted run's, byte for byte apart from wall time."""
 
 from __future__ import annotations
 
-import json
 import shutil
 from pathlib import Path
 
@@ -11,19 +10,8 @@ import pytest
 
 import dial
 from dial.cli import main
-from dial.engine import RunResult
 
-from ..conftest import ROOT
-
-
-def _records(result: RunResult) -> list[dict[str, object]]:
-    """The log as JSON text would hold it, without the summary's wall time."""
-    out = []
-    for record in result.log.records:
-        record = json.loads(json.dumps(record))
-        record.pop("wall_time", None)
-        out.append(record)
-    return out
+from ..conftest import ROOT, json_records
 
 
 def _check_exact(script: str, scene: str | None, block: int, tmp_path: Path) -> None:
@@ -31,11 +19,11 @@ def _check_exact(script: str, scene: str | None, block: int, tmp_path: Path) -> 
     full = dial.run(dial.load(script, scene=scene), save_at=(block, state))
     assert full.saved == ((block, state),), "the save point was never reached"
     resumed = dial.run(dial.load(script, scene=scene), resume=state)
-    tail = [r for r in _records(resumed) if r["kind"] not in ("scene", "resume")]
-    assert tail == _records(full)[-len(tail) :]
+    tail = [r for r in json_records(resumed) if r["kind"] not in ("scene", "resume")]
+    assert tail == json_records(full)[-len(tail) :]
     assert resumed.final_qpos == full.final_qpos  # bit for bit
     assert resumed.ok == full.ok and resumed.summary.sim_time == full.summary.sim_time
-    assert len(tail) < len(_records(full)) - 2  # it did not simply run everything again
+    assert len(tail) < len(json_records(full)) - 2  # it did not simply run everything again
 
 
 @pytest.mark.parametrize(

@@ -11,6 +11,8 @@ import pytest
 
 import dial
 
+from ..conftest import json_records
+
 WORLD = """\
 extends = "surface"
 [locations]
@@ -67,21 +69,12 @@ def test_locate_shifts_the_belief_and_later_moves_follow(script: Path) -> None:
     assert wrist["pos"][1] == pytest.approx(0.010, abs=1e-3)
 
 
-def _records(result: dial.RunResult) -> list[dict[str, object]]:
-    out = []
-    for record in result.log.records:
-        record = json.loads(json.dumps(record))
-        record.pop("wall_time", None)
-        out.append(record)
-    return out
-
-
 def test_a_resumed_run_keeps_the_located_belief(script: Path, tmp_path: Path) -> None:
     state = tmp_path / "locate.state"
     full = dial.run(dial.load(script), save_at=(4, state))  # before the block of "back"
     assert full.saved == ((4, state),)
     assert "believed" in json.loads(state.read_text())
     resumed = dial.run(dial.load(script), resume=state)
-    tail = [r for r in _records(resumed) if r["kind"] not in ("scene", "resume")]
-    assert tail == _records(full)[-len(tail) :]
+    tail = [r for r in json_records(resumed) if r["kind"] not in ("scene", "resume")]
+    assert tail == json_records(full)[-len(tail) :]
     assert resumed.final_qpos == full.final_qpos

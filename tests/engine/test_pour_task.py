@@ -6,27 +6,21 @@ envelope). tests/scenarios runs it at the default tick without perturbation.
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 import pytest
 
 import dial
-from dial.cli import main
 
 from ..conftest import ROOT
+from .recovery import check_recovery, ended
 
 SCRIPT = ROOT / "scripts" / "pour.dial"
 # The documented push: the thumb's fingertip pushed 5 N towards the pitcher for 0.5 s while the
 # hand comes down beside it (lower_pit: 14.32-15.07 s at the default tick, watched to 14.82 s).
 PUSH = "push body=hand_thumb_distal force=0,5,0 at=14.35 for=0.5"
 POURED = {"contents_in_cup": True, "pitcher_upright": True}
-
-
-def _ended(result: dial.RunResult, event: str) -> list[dict[str, Any]]:
-    return [r for r in result.log.of("end") if r["event"] == event]
 
 
 @pytest.mark.parametrize("seed", [1, 12, 22])
@@ -36,9 +30,9 @@ def test_pour_finds_the_lid_by_touch_when_20mm_off(seed: int) -> None:
     result = dial.run(SCRIPT, perturb=20, seed=seed)
     assert result.ok, result.error
     assert result.success == POURED, result.details
-    feels = _ended(result, "feel_knob")
+    feels = ended(result, "feel_knob")
     assert [(r["outcome"], r["data"]["kind"]) for r in feels] == [("done", "tactile")] * 2
-    (found,) = _ended(result, "found")
+    (found,) = ended(result, "found")
     assert found["data"]["objects"] == ["lid", "pitcher"]
     (scene,) = result.log.of("scene")
     # The believed lid and pitcher moved to within 1 mm of where they truly are (0.2-0.6 mm
@@ -56,21 +50,7 @@ def test_pour_at_its_fastest_reliable_tick_when_10mm_off() -> None:
 def test_a_push_on_the_way_down_is_met_by_the_reaction(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    log = tmp_path / "run.jsonl"
-    status = main(["run", str(SCRIPT), "--disturb", PUSH, "--log", str(log), "--json", "--quiet"])
-    summary = json.loads(capsys.readouterr().out.splitlines()[-1])
-    assert status == 0 and summary["ok"] is True, summary["error"]
-    records = [json.loads(line) for line in log.read_text().splitlines()]
-    kinds = [(r["kind"], r.get("event") or r.get("what")) for r in records]
-    pushed = kinds.index(("disturb", PUSH))
-    fired = kinds.index(("monitor", "bump_thumb"))
-    assert pushed < fired  # the thumb felt the push on the way down
-    after = [(k, e, r.get("outcome")) for (k, e), r in zip(kinds, records, strict=True)][fired:]
-    assert after[1] == ("end", "lower_pit", "preempted")  # stopped where it was
-    started = [e for k, e, _ in after if k == "start"]
-    assert started[0] == "back_up"  # the reaction's first run
-    again = after.index(("start", "lower_pit", None))
-    assert ("end", "lower_pit", "done") in after[again:]  # the retried descent went down
+    summary = check_recovery(SCRIPT, PUSH, "bump_thumb", "lower_pit", "back_up", tmp_path, capsys)
     assert summary["success"] == POURED
 
 
