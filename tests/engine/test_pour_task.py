@@ -43,7 +43,7 @@ def test_pour_finds_the_lid_by_touch_when_20mm_off(seed: int) -> None:
 
 
 def test_pour_at_its_fastest_reliable_tick_when_10mm_off() -> None:
-    result = dial.run(SCRIPT, tick=0.15, perturb=10, seed=5)
+    result = dial.run(SCRIPT, tick=0.16, perturb=10, seed=5)
     assert result.ok and result.success == POURED, (result.error, result.details)
 
 
