@@ -80,8 +80,8 @@ def test_pour_tick_ranges_follow_the_paper() -> None:
         ("found", 34, 34),
     ]
     # The paper's lid and approach; the last 13 cm down beside the pitcher is watched, and
-    # each reaction (thumb, middle) backs up and waits for the thumb.
-    assert runs[11:22] == [
+    # each reaction (thumb, middle) backs up and waits for thumb and middle to rest.
+    assert runs[11:24] == [
         ("grab_top", 34, 34),
         ("lift_top", 35, 44),
         ("pit_top", 45, 48),
@@ -89,12 +89,12 @@ def test_pour_tick_ranges_follow_the_paper() -> None:
         ("prepit", 49, 54),
         ("settle", 55, 55),
         ("lower_pit", 56, 58),
-        *[("back_up", 59, 60), ("settle", 61, 61)] * 2,
+        *[("back_up", 59, 60), ("settle", 61, 61), ("settle", 62, 62)] * 2,
     ]
-    assert runs[22:24] == [("grabpit", 62, 62), ("pourpit", 63, 70)]
-    (release, r0, r1), (retract, t0, _) = runs[24:]
+    assert runs[24:26] == [("grabpit", 63, 63), ("pourpit", 64, 71)]
+    (release, r0, r1), (retract, t0, _) = runs[26:]
     assert (release, retract) == ("prepit", "retract_arm")
-    assert 70 < r0 <= r1 < t0
+    assert 71 < r0 <= r1 < t0
 
 
 @pytest.mark.parametrize("name", ["lightbulb.dial", "pour.dial"])
