@@ -269,7 +269,7 @@ def cmd_replay(args: argparse.Namespace) -> int:
 def cmd_tune(args: argparse.Namespace) -> int:
     import math
 
-    from dial.tune import ProcessExecutor, TuneOptions, parse_ticks, tune
+    from dial.tune import ProcessExecutor, TuneOptions, models, parse_ticks, tune
 
     try:
         ticks = parse_ticks(args.ticks)
@@ -292,7 +292,18 @@ def cmd_tune(args: argparse.Namespace) -> int:
         plot=Path(args.plot) if args.plot else None,
         json=args.json,
     )
-    return tune(options, ProcessExecutor(args.jobs))
+    # Each worker compiles a model file once and gives each trial a copy (dial.tune.models).
+    if args.executor == "process":
+        if args.address is not None:
+            raise UsageError("--address needs --executor ray")
+        return tune(options, ProcessExecutor(args.jobs, initializer=models.install))
+    from dial.tune.ray_executor import RayExecutor, RayUsageError
+
+    try:
+        executor = RayExecutor(args.address, args.jobs, initializer=models.install)
+    except RayUsageError as e:
+        raise UsageError(str(e)) from None
+    return tune(options, executor)
 
 
 def _scene_argument(p: argparse.ArgumentParser, checking: bool = False) -> None:
@@ -420,7 +431,8 @@ def build_parser() -> argparse.ArgumentParser:
         "tune",
         help="run a script over a grid of tick lengths and find the fastest reliable one",
         description="Run the script K times at each of N tick lengths from A to B, in "
-        "parallel worker processes, and print success rate and task time per tick length. "
+        "parallel worker processes or as Ray tasks, and print success rate and task time "
+        "per tick length. "
         "Exit 0 when some tick length succeeded in every trial, 1 when none did (or the "
         "plot could not be written), 2 on a usage error. See docs/tuning.md.",
     )
@@ -441,7 +453,25 @@ def build_parser() -> argparse.ArgumentParser:
         help="displace the objects by MM in a direction seeded per trial",
     )
     p.add_argument("--seed", type=int, default=0, metavar="S", help="seed of the trial seeds")
-    p.add_argument("--jobs", type=int, metavar="J", help="worker processes (default: all cores)")
+    p.add_argument(
+        "--jobs",
+        type=int,
+        metavar="J",
+        help="worker processes, or the CPUs of a local Ray (default: all cores)",
+    )
+    p.add_argument(
+        "--executor",
+        choices=("process", "ray"),
+        default="process",
+        help="run the trials in local worker processes (default) or as Ray tasks, "
+        "needs pip install 'dial[ray]'",
+    )
+    p.add_argument(
+        "--address",
+        metavar="ADDR",
+        help="with --executor ray: the Ray cluster, HOST:PORT or auto (default: "
+        "RAY_ADDRESS, else a local Ray started for the sweep)",
+    )
     p.add_argument("--plot", metavar="FILE.png", help="plot success rate and task time")
     p.add_argument("--json", action="store_true", help="print the table as JSON, last line")
     p.set_defaults(func=cmd_tune)

@@ -15,7 +15,7 @@ from typing import TextIO
 from dial.parser.check import load
 from dial.resources import resolve_script
 from dial.scene import load_scene_names
-from dial.tune.executor import Executor, ProcessExecutor, Progress
+from dial.tune.executor import Executor, Progress
 from dial.tune.grid import plan
 from dial.tune.report import fastest_reliable, render_table, summarise, to_json, verdict
 from dial.tune.trial import Backend, engine_backend, sweep
@@ -70,8 +70,8 @@ def tune(
     with _progress_bar(len(trials), err) as progress:
         results = sweep(trials, executor, backend, progress)
     wall = time.perf_counter() - start
-    jobs = f" on {executor.jobs} worker processes" if isinstance(executor, ProcessExecutor) else ""
-    print(f"dial: {len(trials)} trials in {wall:.1f} s wall{jobs}", file=err)
+    where = getattr(executor, "where", "")  # e.g. "on 2 worker processes"
+    print(f"dial: {len(trials)} trials in {wall:.1f} s wall {where}".rstrip(), file=err)
     if options.trials > 1 and options.perturb_mm == 0:
         print("dial: without --perturb, the trials at each tick are the same run", file=err)
 

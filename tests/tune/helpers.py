@@ -41,3 +41,15 @@ def dying(trial: Trial) -> RunReport:
     if trial.tick == BAD_TICK:
         os._exit(3)
     return limited_backend(trial)
+
+
+def dies_once(trial: Trial) -> RunReport:
+    """The worker dies the first time it runs the trial at BAD_TICK, and only then.
+
+    A marker file beside the script remembers the death across worker processes.
+    """
+    marker = Path(trial.script).with_suffix(f".died-{trial.trial}")
+    if trial.tick == BAD_TICK and not marker.exists():
+        marker.touch()
+        os._exit(3)
+    return limited_backend(trial)
