@@ -130,17 +130,22 @@ class RayExecutor:
             self.where = f"on this process's Ray session ({self._cpus()} CPUs)"
             return
         if self.address is None:
-            ray.init(
-                address="local",
-                num_cpus=self.cpus,
-                include_dashboard=False,
-                object_store_memory=LOCAL_OBJECT_STORE,
-                logging_level=logging.ERROR,
-            )
+            try:
+                ray.init(
+                    address="local",
+                    num_cpus=self.cpus,
+                    include_dashboard=False,
+                    object_store_memory=LOCAL_OBJECT_STORE,
+                    logging_level=logging.ERROR,
+                )
+            except Exception as e:  # a port taken, no room for its files, ...
+                raise RayConnectError(f"cannot start a local Ray: {_first_line(str(e))}") from e
             self.where = f"on a local Ray with {self.cpus} CPUs"
         else:
             _connect(ray, self.address)
-            at = self.ray.get_runtime_context().gcs_address  # "auto" resolved
+            at = self.address
+            if at == "auto":
+                at = ray.get_runtime_context().gcs_address
             self.where = f"on the Ray cluster at {at} ({self._cpus()} CPUs)"
         self._opened = True
 
