@@ -9,7 +9,10 @@ are interleaved `--repeat` times and the fastest of each kind counts.
 
 The load average is printed first: other processes on the machine take cores from the
 workers. "cores busy" is the workers' CPU time over the wall time, so a speed-up below J
-with fewer than J cores busy means the workers waited for CPU.
+with fewer than J cores busy means the workers waited for CPU. How long each worker waited
+for a CPU is measured (Linux, /proc/PID/schedstat: time runnable but not running), and the
+speed-up is printed a second time with that wait taken out of each worker's time: the
+figure for a machine with nothing else running.
 
     python benchmarks/bench_tune.py [SCRIPT] [--ticks A:B:N] [--trials K] [--jobs J]
                                     [--repeat N] [--no-ray]
@@ -20,19 +23,42 @@ from __future__ import annotations
 import argparse
 import os
 import resource
+import tempfile
 import time
+from pathlib import Path
 
 from dial.resources import resolve_script
 from dial.tune import (
     ProcessExecutor,
     RayExecutor,
+    RunReport,
     Trial,
     TrialResult,
+    engine_backend,
     models,
     parse_ticks,
     plan,
     sweep,
 )
+
+WAITS = "DIAL_BENCH_WAITS"  # the folder where each worker notes its clock and CPU wait
+
+
+def _engine_noting_waits(trial: Trial) -> RunReport:
+    """engine_backend, then note when it ended and how long this worker has waited for CPU."""
+    report = engine_backend(trial)
+    waited_ns = int(Path("/proc/self/schedstat").read_text().split()[1])
+    note = f"{time.perf_counter()} {waited_ns / 1e9}"  # perf_counter: one clock for all
+    (Path(os.environ[WAITS]) / str(os.getpid())).write_text(note)
+    return report
+
+
+def _without_waits(start: float, wall: float, folder: Path) -> float:
+    """The sweep's wall time with each worker's wait for a CPU taken out of its time."""
+    notes = [f.read_text().split() for f in folder.iterdir()]
+    ends = [(float(end) - start, float(waited)) for end, waited in notes]
+    last = max(end for end, _ in ends)
+    return max(end - waited for end, waited in ends) + (wall - last)  # + the pool's shutdown
 
 
 def _children_cpu() -> float:
@@ -40,13 +66,17 @@ def _children_cpu() -> float:
     return usage.ru_utime + usage.ru_stime
 
 
-def _processes(trials: list[Trial], jobs: int) -> tuple[float, float, list[TrialResult]]:
-    """Wall time, workers' CPU time and results of the sweep on a pool of ``jobs``."""
-    cpu = _children_cpu()
-    start = time.perf_counter()
-    results = sweep(trials, ProcessExecutor(jobs, initializer=models.install))
-    wall = time.perf_counter() - start
-    return wall, _children_cpu() - cpu, results  # workers are joined when the pool shuts down
+def _processes(trials: list[Trial], jobs: int) -> tuple[float, float, float, list[TrialResult]]:
+    """Wall time, the same without the waits for CPU, workers' CPU time, and the results."""
+    with tempfile.TemporaryDirectory() as folder:
+        os.environ[WAITS] = folder  # spawned workers inherit it
+        cpu = _children_cpu()
+        start = time.perf_counter()
+        executor = ProcessExecutor(jobs, initializer=models.install)
+        results = sweep(trials, executor, _engine_noting_waits)
+        wall = time.perf_counter() - start
+        alone = _without_waits(start, wall, Path(folder))
+    return wall, alone, _children_cpu() - cpu, results  # workers are joined at shutdown
 
 
 def _ray(trials: list[Trial], cpus: int) -> tuple[float, float, list[TrialResult]]:
@@ -77,9 +107,13 @@ def main() -> None:
     reference: list[TrialResult] | None = None
     for _ in range(args.repeat):
         for jobs in (1, args.jobs):
-            wall, cpu, results = _processes(trials, jobs)
+            wall, alone, cpu, results = _processes(trials, jobs)
             best[f"jobs {jobs}"] = min(wall, best.get(f"jobs {jobs}", wall))
-            print(f"  --jobs {jobs:<2}          {wall:6.1f} s wall, {cpu / wall:.2f} cores busy")
+            best[f"alone {jobs}"] = min(alone, best.get(f"alone {jobs}", alone))
+            print(
+                f"  --jobs {jobs:<2}          {wall:6.1f} s wall, {cpu / wall:.2f} cores busy, "
+                f"{alone:.1f} s without the waits for a CPU"
+            )
             reference = reference or results
             assert results == reference, "a sweep gave different results: not deterministic"
         if not args.no_ray:
@@ -91,6 +125,8 @@ def main() -> None:
     print(f"load average after: {os.getloadavg()[0]:.2f}")
     speedup = best["jobs 1"] / best[f"jobs {args.jobs}"]
     print(f"speed-up of --jobs {args.jobs} over --jobs 1: {speedup:.2f}")
+    alone = best["alone 1"] / best[f"alone {args.jobs}"]
+    print(f"  the same without the waits for a CPU (the machine to itself): {alone:.2f}")
     if not args.no_ray:
         print(
             f"local Ray with {args.jobs} CPUs: {best['ray']:.1f} s wall "
