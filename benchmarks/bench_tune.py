@@ -1,8 +1,9 @@
 """`dial tune` speed-up with J worker processes, and the same sweep on a local Ray (DESIGN 7).
 
 Runs the same sweep with `--jobs 1` and with `--jobs J` (default 2) as `dial tune` does
-(each worker compiles its models once) and prints the speed-up (target: 1.8 or more with
-2 jobs on a 2-core machine). Then it runs the sweep as Ray tasks on a local Ray with J
+(workers forked from a server that imported the engine once, each compiling its models
+once; `--method spawn` for fresh interpreters instead) and prints the speed-up (target:
+1.8 or more with 2 jobs on a 2-core machine). Then it runs the sweep as Ray tasks on a local Ray with J
 CPUs, started for it as `dial tune --executor ray` does, and prints its wall time beside,
 with the time Ray took to start apart. Every run must give the same results. The runs
 are interleaved `--repeat` times and the fastest of each kind counts.
@@ -15,7 +16,7 @@ speed-up is printed a second time with that wait taken out of each worker's time
 figure for a machine with nothing else running.
 
     python benchmarks/bench_tune.py [SCRIPT] [--ticks A:B:N] [--trials K] [--jobs J]
-                                    [--repeat N] [--no-ray]
+                                    [--repeat N] [--method forkserver|spawn] [--no-ray]
 """
 
 from __future__ import annotations
@@ -66,13 +67,15 @@ def _children_cpu() -> float:
     return usage.ru_utime + usage.ru_stime
 
 
-def _processes(trials: list[Trial], jobs: int) -> tuple[float, float, float, list[TrialResult]]:
+def _processes(
+    trials: list[Trial], jobs: int, method: str
+) -> tuple[float, float, float, list[TrialResult]]:
     """Wall time, the same without the waits for CPU, workers' CPU time, and the results."""
     with tempfile.TemporaryDirectory() as folder:
-        os.environ[WAITS] = folder  # spawned workers inherit it
+        os.environ[WAITS] = folder  # read by the workers: set before the pool starts
         cpu = _children_cpu()
         start = time.perf_counter()
-        executor = ProcessExecutor(jobs, initializer=models.install)
+        executor = ProcessExecutor(jobs, method, models.install, models.PRELOAD)
         results = sweep(trials, executor, _engine_noting_waits)
         wall = time.perf_counter() - start
         alone = _without_waits(start, wall, Path(folder))
@@ -96,6 +99,7 @@ def main() -> None:
     parser.add_argument("--trials", type=int, default=2)
     parser.add_argument("--jobs", type=int, default=2)
     parser.add_argument("--repeat", type=int, default=1)
+    parser.add_argument("--method", default="forkserver", choices=("forkserver", "spawn"))
     parser.add_argument("--no-ray", action="store_true", help="only the process pool")
     args = parser.parse_args()
 
@@ -107,7 +111,7 @@ def main() -> None:
     reference: list[TrialResult] | None = None
     for _ in range(args.repeat):
         for jobs in (1, args.jobs):
-            wall, alone, cpu, results = _processes(trials, jobs)
+            wall, alone, cpu, results = _processes(trials, jobs, args.method)
             best[f"jobs {jobs}"] = min(wall, best.get(f"jobs {jobs}", wall))
             best[f"alone {jobs}"] = min(alone, best.get(f"alone {jobs}", alone))
             print(

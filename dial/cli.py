@@ -296,7 +296,8 @@ def cmd_tune(args: argparse.Namespace) -> int:
     if args.executor == "process":
         if args.address is not None:
             raise UsageError("--address needs --executor ray")
-        return tune(options, ProcessExecutor(args.jobs, initializer=models.install))
+        pool = ProcessExecutor(args.jobs, initializer=models.install, preload=models.PRELOAD)
+        return tune(options, pool)
     from dial.tune.ray_executor import RayExecutor, RayUsageError
 
     try:

@@ -24,6 +24,9 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:
     import mujoco
 
+# What a worker of an engine sweep imports: a fork server imports it once for all of them.
+PRELOAD = ("dial.engine", "dial.parser.check", "dial.scene", "dial.tune.models")
+
 _compiled: dict[tuple[str, int], mujoco.MjModel] = {}
 
 
