@@ -1,28 +1,25 @@
-"""Sensing: snapshots into the log, contact waits, contact points and fits."""
+"""Sensing: snapshots into the log, contact waits and tests, contact points and fits."""
 
 from __future__ import annotations
 
-from typing import Any
-
-import mujoco
 import numpy as np
 
 from dial.backend.contact import contact_reading
 from dial.backend.snapshot import FloatArray, Snapshot
 from dial.haptics import FitError, fit_plane, fit_superquadric
+from dial.instructions.catalogue import contact_condition
 from dial.instructions.types import FINGERS
 from dial.primitives.context import Context, RobotPrimitive, done, missed
-from dial.scheduler.types import Ended, InstantPrimitive, Now, Outcome, RunInfo
+from dial.scheduler.types import Ended, Now, Outcome, RunInfo
 
 
-class Get(InstantPrimitive):
+class Get:
     """``get_joints``, ``get_forces``, ``get_tactile``, ``get_wrist``: record a snapshot."""
 
     def __init__(self, ctx: Context, info: RunInfo) -> None:
         self.what = info.event.instruction.name
 
-    def sense(self, snapshot: Any) -> Ended:
-        assert isinstance(snapshot, Snapshot)
+    def sense(self, snapshot: Snapshot) -> Ended:
         if self.what == "get_joints":
             return done(hand_q=snapshot.hand_q, arm_q=snapshot.arm_q)
         if self.what == "get_forces":
@@ -33,7 +30,10 @@ class Get(InstantPrimitive):
 
 
 def contact_value(kind: str, snapshot: Snapshot, finger: int, baseline: FloatArray | None) -> float:
-    """The reading a contact condition compares with its threshold (m or N)."""
+    """The reading a contact condition compares with its threshold (m or N); a dropped-out
+    sensor reads 0, as the driver's guards read it."""
+    if (kind, finger) in snapshot.dropped:
+        return 0.0
     return contact_reading(
         kind,
         finger,
@@ -46,75 +46,53 @@ def contact_value(kind: str, snapshot: Snapshot, finger: int, baseline: FloatArr
 
 
 class ContactWait(RobotPrimitive):
-    """``position_contact``, ``force_contact``, ``tactile_contact``: wait for the signal."""
+    """``position_contact``, ``force_contact``, ``tactile_contact``.
+
+    In a diagram: wait until the contact is signalled (a force change counts from the
+    run's start). As a condition-only event: is the contact there now (:meth:`sense`)?
+    """
 
     def __init__(self, ctx: Context, info: RunInfo) -> None:
         super().__init__(ctx, info)
-        self.kind = info.event.instruction.name.removesuffix("_contact")
-        self.finger = int(self.arg("finger"))
-        self.threshold = float(self.arg("threshold"))
+        self.kind, self.finger, self.threshold = contact_condition(
+            info.event.instruction, info.event.args
+        )
 
-    def start(self, snapshot: Any) -> None:
-        assert isinstance(snapshot, Snapshot)
+    def start(self, snapshot: Snapshot) -> None:
         self.baseline = snapshot.differentials.copy()
 
-    def step(self, snapshot: Any, now: Now) -> Ended | None:
-        assert isinstance(snapshot, Snapshot)
+    def step(self, snapshot: Snapshot, now: Now) -> Ended | None:
         value = contact_value(self.kind, snapshot, self.finger, self.baseline)
         return done(value=value) if value >= self.threshold else None
 
-
-class ContactTest(InstantPrimitive):
-    """A contact wait used as a condition-only event: is there contact now?"""
-
-    def __init__(self, ctx: Context, info: RunInfo) -> None:
-        self.kind = info.event.instruction.name.removesuffix("_contact")
-        self.finger = int(info.event.args["finger"])
-        self.threshold = float(info.event.args["threshold"])
-
-    def sense(self, snapshot: Any) -> Ended:
-        assert isinstance(snapshot, Snapshot)
+    def sense(self, snapshot: Snapshot) -> Ended:
         value = contact_value(self.kind, snapshot, self.finger, None)
         if value >= self.threshold:
             return done(value=value)
         return missed(f"no {self.kind} contact on the {FINGERS[self.finger]}", value=value)
 
 
-def taxel_points(ctx: Context, finger: int) -> FloatArray:
-    """(256, 3) world positions of a fingertip's taxels, in sensor order."""
-    model, data = ctx.robot.model, ctx.robot.data
-    sensor = int(
-        mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SENSOR, f"hand_{FINGERS[finger]}_tactile")
-    )
-    # A tactile sensor's object is its mesh; its reference is the geom that carries it.
-    mesh, geom = int(model.sensor_objid[sensor]), int(model.sensor_refid[sensor])
-    adr, n = int(model.mesh_vertadr[mesh]), int(model.mesh_vertnum[mesh])
-    local = model.mesh_vert[adr : adr + n].astype(np.float64)
-    rot = data.geom_xmat[geom].reshape(3, 3)
-    points: FloatArray = data.geom_xpos[geom] + local @ rot.T
-    return points
-
-
-class RecordContact(InstantPrimitive):
+class RecordContact:
     """``record_contact finger=F [into=SET]``: the depth-weighted taxel centroid, world frame."""
 
     def __init__(self, ctx: Context, info: RunInfo) -> None:
         self.ctx = ctx
-        self.finger = int(info.event.args["finger"])
+        finger = info.event.args["finger"]
+        assert isinstance(finger, int)
+        self.finger = finger
         self.set = str(info.event.args["into"])
 
-    def sense(self, snapshot: Any) -> Ended:
-        assert isinstance(snapshot, Snapshot)
+    def sense(self, snapshot: Snapshot) -> Ended:
         depth = snapshot.tactile[self.finger].reshape(-1)
         if depth.max() <= 0.0:
             return missed(f"the {FINGERS[self.finger]} fingertip touches nothing")
-        points = taxel_points(self.ctx, self.finger)
+        points = self.ctx.robot.taxel_points(self.finger)
         point = (depth @ points) / depth.sum()
         self.ctx.point_sets.setdefault(self.set, []).append([float(x) for x in point])
         return done(point=point, set=self.set, count=len(self.ctx.point_sets[self.set]))
 
 
-class Fit(InstantPrimitive):
+class Fit:
     """``fit_plane SET`` and ``fit_superquadric SET``: least squares over a point set."""
 
     def __init__(self, ctx: Context, info: RunInfo) -> None:
@@ -122,7 +100,7 @@ class Fit(InstantPrimitive):
         self.set = str(info.event.args["set"])
         self.kind = info.event.instruction.name
 
-    def sense(self, snapshot: Any) -> Ended:
+    def sense(self, snapshot: Snapshot) -> Ended:
         points = np.array(self.ctx.point_sets.get(self.set, []), dtype=np.float64).reshape(-1, 3)
         try:
             fit = fit_plane(points) if self.kind == "fit_plane" else fit_superquadric(points)
@@ -131,14 +109,3 @@ class Fit(InstantPrimitive):
         result = fit.as_result()
         self.ctx.results[self.set] = result
         return done(set=self.set, points=len(points), **result)
-
-
-def make_sensing(ctx: Context, info: RunInfo) -> Any:
-    name = info.event.instruction.name
-    if name.startswith("get_"):
-        return Get(ctx, info)
-    if name == "record_contact":
-        return RecordContact(ctx, info)
-    if name.startswith("fit_"):
-        return Fit(ctx, info)
-    return ContactTest(ctx, info) if info.instant else ContactWait(ctx, info)

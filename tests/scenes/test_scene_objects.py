@@ -3,16 +3,18 @@
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import mujoco
 import numpy as np
 import pytest
 
-from dial.scene.thread import find_threads
+from dial.scene import WorldFileError, load_world, worlds_dir
+from dial.scene.thread import find_threads, set_turns
 
-from .conftest import ObjectWorld, step, warnings
+from .conftest import ObjectWorld, step, warnings, write
 
-BALLS = [f"pour_ball_{k:02d}" for k in range(36)]
+BALLS = [f"pour_ball_{k:02d}" for k in range(20)]
 PITCH = 0.004  # m per turn
 TURNS = 1.5
 
@@ -30,14 +32,45 @@ GRIP = '<body name="grip" mocap="true" pos="0.55 -0.12 0.35"/>'
 WELD = '<weld body1="grip" body2="pour_pitcher"/>'
 
 
+def _asleep(model: mujoco.MjModel, data: mujoco.MjData, bodies: list[str]) -> int:
+    trees = model.body_treeid[[model.body(b).id for b in bodies]]
+    return int((data.tree_asleep[trees] >= 0).sum())
+
+
+def test_balls_start_at_rest_and_sleep(object_world: ObjectWorld) -> None:
+    model, data = object_world("pour")
+    assert model.opt.enableflags & mujoco.mjtEnableBit.mjENBL_SLEEP
+    ids = [model.body(b).id for b in BALLS]
+    start = data.xpos[ids].copy()
+    assert _asleep(model, data, BALLS) == 0
+    step(model, data, 0.1)
+    # The written positions are the resting ones: the pile sleeps at once, where it was put.
+    pile = [*BALLS, "pour_pitcher", "pour_lid", "pour_cup"]
+    assert _asleep(model, data, pile) == len(pile)
+    assert np.abs(data.xpos[ids] - start).max() < 2e-4
+
+
 def test_balls_stay_in_the_pitcher_at_rest(object_world: ObjectWorld) -> None:
     model, data = object_world("pour")
     assert _in_site(model, data, BALLS, "pour_pitcher_inside") == len(BALLS)
     step(model, data, 2.0)
     assert _in_site(model, data, BALLS, "pour_pitcher_inside") == len(BALLS)
-    ids = [model.body(b).id for b in BALLS]
-    assert np.abs(data.cvel[ids, 3:]).max() < 0.01  # settled (frictionless balls may spin)
+    assert _asleep(model, data, BALLS) == len(BALLS)  # no ball spins on: damping stops it
     assert warnings(data) == 0
+
+
+def test_a_spinning_ball_wakes_the_pile_and_it_sleeps_again(object_world: ObjectWorld) -> None:
+    model, data = object_world("pour")
+    step(model, data, 0.2)
+    # Spin about the vertical: no contact of a ball resists it (frictionless neighbours, no
+    # torsional friction on the floor), so only the joint damping can stop it.
+    dof = model.jnt_dofadr[model.body("pour_ball_06").jntadr[0]]
+    data.qvel[dof + 5] = 20.0
+    step(model, data, 0.01)
+    assert _asleep(model, data, BALLS) == 0
+    step(model, data, 1.5)
+    assert _asleep(model, data, BALLS) == len(BALLS)
+    assert _in_site(model, data, BALLS, "pour_pitcher_inside") == len(BALLS)
 
 
 def test_balls_pour_out_when_the_pitcher_tilts_120_degrees(object_world: ObjectWorld) -> None:
@@ -143,6 +176,31 @@ def test_thread_engages_again_after_reset(object_world: ObjectWorld) -> None:
     assert thread.update(data) and not thread.update(data)
     mujoco.mj_resetData(model, data)
     assert thread.engaged(data)
+
+
+def test_a_world_file_sets_the_turns_before_the_thread_lets_go(
+    object_world: ObjectWorld, tmp_path: Path
+) -> None:
+    model, data = object_world("lightbulb")
+    set_turns(model, load_world(worlds_dir() / "lightbulb_long.toml"))
+    (thread,) = find_threads(model)
+    assert thread.release_turn == pytest.approx(2 * math.pi * 3.5, abs=0.02)
+    half = write(tmp_path / "half.toml", 'extends = "lightbulb"\n[thread]\nturns = 0.5\n')
+    set_turns(model, load_world(half))
+    (thread,) = find_threads(model)
+    bulb = model.body("lightbulb_bulb").id
+    z0 = data.xpos[bulb, 2]
+    assert _twist(model, data, 0.08, 2.0, speed=3.0)  # free after half a turn, 2 mm up
+    assert data.qpos[thread.turn_qpos] / (2 * math.pi) == pytest.approx(0.5, abs=0.03)
+    assert data.xpos[bulb, 2] - z0 == pytest.approx(0.5 * PITCH, abs=3e-4)
+
+
+def test_thread_turns_need_a_model_with_a_thread(object_world: ObjectWorld) -> None:
+    model, _ = object_world("pour")
+    set_turns(model, load_world(worlds_dir() / "pour.toml"))  # no [thread]: nothing to do
+    world = load_world(worlds_dir() / "lightbulb_long.toml")
+    with pytest.raises(WorldFileError, match=r"lightbulb_long.toml: thread: .* no screw thread"):
+        set_turns(model, world)
 
 
 # Resting solids ---------------------------------------------------------------------------
