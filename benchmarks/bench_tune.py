@@ -3,10 +3,10 @@
 Runs the same sweep with `--jobs 1` and with `--jobs J` (default 2) as `dial tune` does
 (workers forked from a server that imported the engine once, each compiling its models
 once; `--method spawn` for fresh interpreters instead) and prints the speed-up (target:
-1.8 or more with 2 jobs on a 2-core machine). Then it runs the sweep as Ray tasks on a local Ray with J
-CPUs, started for it as `dial tune --executor ray` does, and prints its wall time beside,
-with the time Ray took to start apart. Every run must give the same results. The runs
-are interleaved `--repeat` times and the fastest of each kind counts.
+1.8 or more with 2 jobs on a 2-core machine). Then it runs the sweep as Ray tasks on a
+local Ray with J CPUs, started for it as `dial tune --executor ray` does, and prints its
+wall time beside, with the time Ray took to start apart. Every run must give the same
+results. The runs are interleaved `--repeat` times and the fastest of each kind counts.
 
 The load average is printed first: other processes on the machine take cores from the
 workers. "cores busy" is the workers' CPU time over the wall time, so a speed-up below J
