@@ -4,8 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-import dial.backend.ik
-import dial.engine
+from dial.backend import model
 from dial.resources import resolve_script
 from dial.tune import engine_backend, models, plan, run_trial
 
@@ -13,9 +12,7 @@ from dial.tune import engine_backend, models, plan, run_trial
 def test_a_worker_compiles_each_model_once_and_its_trials_give_the_same_results(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
-    for module in (dial.engine, dial.backend.ik):  # undone after the test
-        monkeypatch.setattr(module, "load_model", module.load_model)
-    monkeypatch.setattr(models, "_compiled", {})
+    monkeypatch.setattr(model, "_compiled", None)  # undone after the test
     path = resolve_script("lightbulb")
     # --perturb moves the lamp, a fixed body, in the model: each trial needs its own copy.
     trials = plan(str(path), "lightbulb.dial", (0.05,), 2, perturb_mm=5)
@@ -24,5 +21,5 @@ def test_a_worker_compiles_each_model_once_and_its_trials_give_the_same_results(
     models.install()  # a Ray worker installs it before every task
     assert [run_trial(engine_backend, t) for t in trials] == fresh
     # The scene, and the robot alone for the two IK solvers, were each compiled once.
-    assert models.compiled() == 2
+    assert model.compiled_count() == 2
     assert all(r.error is None for r in fresh)
