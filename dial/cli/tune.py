@@ -7,6 +7,7 @@ from pathlib import Path
 
 from dial import api
 from dial.cli.common import UsageError, at_least, scene_argument
+from dial.disturb import parse_disturbance
 from dial.instructions.scene_names import SceneNotFoundError
 
 
@@ -37,6 +38,14 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         help="displace the objects by MM in a direction seeded per trial",
     )
     p.add_argument("--seed", type=int, default=0, metavar="S", help="seed of the trial seeds")
+    p.add_argument(
+        "--disturb",
+        action="append",
+        default=[],
+        metavar="SPEC",
+        help="a deliberate fault in every trial, repeatable, as for dial run: 'push body=NAME "
+        "force=FX,FY,FZ at=T for=D' or 'sense sensor=KIND:FINGER at=T [for=D]'",
+    )
     p.add_argument(
         "--jobs",
         type=int,
@@ -72,6 +81,8 @@ def cmd_tune(args: argparse.Namespace) -> int:
     at_least("--trials", args.trials, 1)
     at_least("--jobs", args.jobs, 1)
     api.check_options(None, 1.0, args.seed, args.perturb)
+    for spec in args.disturb:  # a bad SPEC is a usage error before anything runs
+        parse_disturbance(spec)
     try:
         scene = None if args.scene is None else scene_option(args.scene)
     except SceneNotFoundError as e:
@@ -85,6 +96,7 @@ def cmd_tune(args: argparse.Namespace) -> int:
         seed=args.seed,
         plot=Path(args.plot) if args.plot else None,
         json=args.json,
+        disturb=tuple(args.disturb),
     )
     # Each worker compiles a model file once and gives each trial a copy (dial.tune.models).
     if args.executor == "process":
