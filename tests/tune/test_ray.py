@@ -7,6 +7,7 @@ get the test backends by value, as they cannot import the ``tests`` package.
 from __future__ import annotations
 
 import json
+import time
 from collections.abc import Iterator
 from io import StringIO
 from pathlib import Path
@@ -85,6 +86,21 @@ def test_a_worker_killed_in_the_middle_of_a_sweep_reruns_its_trial(
     assert (tmp_path / "go.died-0").exists()  # the worker running 0.3 s did die
     assert results == sweep(trials, SerialExecutor(), limited_backend)
     assert done == list(range(1, 11))
+
+
+def test_ctrl_c_cancels_the_tasks_not_yet_run(tmp_path: Path, local_ray: RayExecutor) -> None:
+    # Ctrl-C arrives as the first result comes in (dial's CLI then exits 130): the tasks
+    # still queued must never start. Each trial marks its start and then takes a second.
+    trials = plan(str(helpers.write_go(tmp_path)), "go.dial", parse_ticks("0.1:1:10"), 1)
+
+    def interrupt(done: int) -> None:
+        raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        sweep(trials, local_ray, helpers.slow, interrupt)
+    time.sleep(3.0)  # without the cancel, 2 CPUs would have started 4-6 more trials by now
+    started = list(tmp_path.glob("go.started-*"))
+    assert 1 <= len(started) <= 4, started  # the first pair, and a pair already handed out
 
 
 def test_the_cli_runs_a_real_engine_trial_on_ray_as_in_processes(
