@@ -10,13 +10,14 @@ where it is first sensed. Engine-owned safety monitors run every period.
 from __future__ import annotations
 
 from collections.abc import Iterable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import mujoco
 import numpy as np
 import trio
 
 from dial.backend.contact import contact_reading
+from dial.backend.locate import finger_bodies, link_point, tactile_point
 from dial.backend.model import HAND_JOINTS, RobotIndex, hand_ctrl, tendon_differentials
 from dial.backend.snapshot import FloatArray, Snapshot, Trip, frozen
 from dial.errors import DialError
@@ -78,6 +79,7 @@ class MujocoRobot:
         self._arm_lo = arm_range[:, 0] - LIMIT_SLACK
         self._arm_hi = arm_range[:, 1] + LIMIT_SLACK
         self._pinned_at = ix.tension_limit - 1e-6
+        self._finger_bodies = tuple(finger_bodies(model, f) for f in range(len(FINGERS)))
         hand_joints = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, n) for n in HAND_JOINTS]
         self.hand_range = model.jnt_range[hand_joints].copy()  # (16, 2) rad, mask order
         self.pace: float | None = None  # wall seconds per simulated second, for --realtime
@@ -185,8 +187,16 @@ class MujocoRobot:
                     kind, f, sd[a : a + 256], differentials, self.hand_target, q, guard.baseline
                 )
                 if value >= threshold:
-                    return Trip(self.time, self.steps, kind, f, value)
+                    return self._located(Trip(self.time, self.steps, kind, f, value))
         return None
+
+    def _located(self, trip: Trip) -> Trip:
+        """``trip`` with where its finger touches at this physics step."""
+        m, d, f = self.model, self.data, trip.finger
+        a = self._tactile_adr[f]
+        tactile = tactile_point(m, d, f, d.sensordata[a : a + 256])
+        link = link_point(m, d, self._finger_bodies[f])
+        return replace(trip, tactile=tactile, link=link)
 
     def _trip(self, gid: int, guard: Guard, trip: Trip) -> None:
         self._trips[gid] = trip

@@ -44,6 +44,19 @@ def location_pose(
     return body_pos + body_rot @ pos, body_rot @ rot
 
 
+@dataclass(frozen=True)
+class StopContact:
+    """Where a finger touched when a guarded move stopped on its contact (world m).
+
+    ``tactile``: the taxel centroid, None when the array felt nothing (the contact was on
+    the cap or a phalanx); ``link``: the contact point of the finger's links, None when they
+    touched nothing outside the robot. See :mod:`dial.backend.locate`.
+    """
+
+    tactile: FloatArray | None
+    link: FloatArray | None
+
+
 @dataclass
 class Context:
     """Shared by the primitives of one run.
@@ -59,6 +72,8 @@ class Context:
     arm_ik: ArmIK = field(default_factory=ArmIK)
     finger_ik: FingerIK = field(default_factory=FingerIK)
     point_sets: dict[str, list[list[float]]] = field(default_factory=dict)
+    # finger -> where it touched when the latest guarded move sensing it stopped on contact
+    stops: dict[int, StopContact] = field(default_factory=dict)
     results: dict[str, dict[str, Any]] = field(default_factory=dict)
 
     def location(self, name: str) -> tuple[FloatArray, FloatArray]:

@@ -4,10 +4,10 @@ from __future__ import annotations
 
 from typing import Any
 
-import mujoco
 import numpy as np
 
 from dial.backend.contact import contact_reading
+from dial.backend.locate import finger_bodies, link_point, tactile_point
 from dial.backend.snapshot import FloatArray, Snapshot
 from dial.haptics import FitError, fit_plane, fit_superquadric
 from dial.instructions.types import FINGERS
@@ -80,38 +80,44 @@ class ContactTest(InstantPrimitive):
         return missed(f"no {self.kind} contact on the {FINGERS[self.finger]}", value=value)
 
 
-def taxel_points(ctx: Context, finger: int) -> FloatArray:
-    """(256, 3) world positions of a fingertip's taxels, in sensor order."""
-    model, data = ctx.robot.model, ctx.robot.data
-    sensor = int(
-        mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SENSOR, f"hand_{FINGERS[finger]}_tactile")
-    )
-    # A tactile sensor's object is its mesh; its reference is the geom that carries it.
-    mesh, geom = int(model.sensor_objid[sensor]), int(model.sensor_refid[sensor])
-    adr, n = int(model.mesh_vertadr[mesh]), int(model.mesh_vertnum[mesh])
-    local = model.mesh_vert[adr : adr + n].astype(np.float64)
-    rot = data.geom_xmat[geom].reshape(3, 3)
-    points: FloatArray = data.geom_xpos[geom] + local @ rot.T
-    return points
-
-
 class RecordContact(InstantPrimitive):
-    """``record_contact finger=F [into=SET]``: the depth-weighted taxel centroid, world frame."""
+    """``record_contact finger=F [into=SET] [at=now|stop] [source=tactile|links]``.
+
+    Appends where the finger touches (world m) to a point set: the depth-weighted taxel
+    centroid (``source=tactile``) or the contact point of its links (``source=links``), now
+    or as it was when the latest guarded move sensing this finger stopped (``at=stop``).
+    """
 
     def __init__(self, ctx: Context, info: RunInfo) -> None:
         self.ctx = ctx
         self.finger = int(info.event.args["finger"])
         self.set = str(info.event.args["into"])
+        self.at = str(info.event.args["at"])
+        self.source = str(info.event.args["source"])
 
     def sense(self, snapshot: Any) -> Ended:
         assert isinstance(snapshot, Snapshot)
-        depth = snapshot.tactile[self.finger].reshape(-1)
-        if depth.max() <= 0.0:
-            return missed(f"the {FINGERS[self.finger]} fingertip touches nothing")
-        points = taxel_points(self.ctx, self.finger)
-        point = (depth @ points) / depth.sum()
-        self.ctx.point_sets.setdefault(self.set, []).append([float(x) for x in point])
-        return done(point=point, set=self.set, count=len(self.ctx.point_sets[self.set]))
+        name = FINGERS[self.finger]
+        if self.at == "stop":
+            stop = self.ctx.stops.get(self.finger)
+            if stop is None:
+                return missed(f"no guarded move stopped on a contact of the {name}")
+            point = stop.tactile if self.source == "tactile" else stop.link
+        else:
+            point = self._now(snapshot)
+        if point is None:
+            where = "fingertip array" if self.source == "tactile" else "links"
+            when = "at the stop" if self.at == "stop" else "now"
+            return missed(f"the {name} {where} touched nothing {when}")
+        points = self.ctx.point_sets.setdefault(self.set, [])
+        points.append([float(x) for x in point])
+        return done(point=point, set=self.set, count=len(points))
+
+    def _now(self, snapshot: Snapshot) -> FloatArray | None:
+        model, data = self.ctx.robot.model, self.ctx.robot.data
+        if self.source == "tactile":
+            return tactile_point(model, data, self.finger, snapshot.tactile[self.finger])
+        return link_point(model, data, finger_bodies(model, self.finger))
 
 
 class Fit(InstantPrimitive):

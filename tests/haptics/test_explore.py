@@ -14,6 +14,8 @@ import pytest
 from .test_procedures import _run
 
 SURFACE, CONTAIN = "scripts/explore_surface.dial", "scripts/containment.dial"
+# The procedures' own calls: containment.dial runs one side per azimuth.
+NESTED = {SURFACE: [], CONTAIN: ["scripts/containment_side.dial"] * 8}
 
 
 # The pad starts 116.3 mm above the object's centre (20 mm south of it); the first touch is
@@ -45,7 +47,7 @@ def test_explore_calls_the_procedure_the_object_needs(
     conditions = {r["condition"]: r["value"] for r in records if r["kind"] == "condition"}
     assert conditions["!find"] is False and conditions["wide"] is wide
     calls = [r["script"] for r in records if r["kind"] == "call"]
-    assert calls == [called]
+    assert calls == [called, *NESTED[called]]
     other = CONTAIN if called == SURFACE else SURFACE
     ran = {r.get("script") for r in records if r["kind"] == "start"}
     assert called in ran and other not in ran
