@@ -37,8 +37,7 @@ TIE_RTOL = 1e-6  # costs this close (relative) are the same fit
 # a few contacts off the model (on a sharp edge, which no superquadric reaches exactly, or a
 # stray contact) pull the fit less.
 LOSS_SCALE = 0.003
-# Multi-start in two rounds: every start for a few evaluations, then the best few to the end.
-SCOUT_EVALUATIONS, FINALISTS, FINAL_EVALUATIONS = 50, 2, 2000
+MAX_EVALUATIONS = 2000  # per start
 
 
 class FitError(ValueError):
@@ -161,8 +160,7 @@ def fit_superquadric(
     bottom of an object standing on a table) at the outermost contacts.
 
     Each start in ``starts`` (eps1, eps2) is tried with each principal axis of the points as
-    z, from the centre and half-ranges of their principal-axis bounding box, for
-    ``SCOUT_EVALUATIONS``; the ``FINALISTS`` best run on to convergence, and the one with the
+    z, from the centre and half-ranges of their principal-axis bounding box; the fit with the
     lowest objective wins. Raises :class:`FitError` for fewer than 11 points (one per parameter),
     non-finite values, or points that span no volume (collinear or coplanar).
     """
@@ -184,19 +182,15 @@ def fit_superquadric(
     # side no point constrains from running away.
     size_bounds = (np.full(3, 1e-3), np.full(3, 2.0 * float(np.max(high - low))))
 
-    runs = []
+    best: tuple[float, float, Array, Array] | None = None
     for frame, sizes in _frames(vt, half):
         for start in starts:
             x0 = np.concatenate([sizes, start, mid, np.zeros(3)])
-            runs.append((*_solve(q, frame, x0, size_bounds, SCOUT_EVALUATIONS), frame))
-    # A stable sort and a near-tie that keeps the earlier run: boxes and ellipsoids fit
-    # equally well with any axis as z, and rounding must not decide which axis is z.
-    runs.sort(key=lambda run: run[0])
-    best: tuple[float, float, Array, Array] | None = None
-    for _, _, x0, frame in runs[:FINALISTS]:
-        robust, cost, x = _solve(q, frame, x0, size_bounds, FINAL_EVALUATIONS)
-        if best is None or robust < best[0] * (1.0 - TIE_RTOL):
-            best = (robust, cost, x, frame)
+            robust, cost, x = _solve(q, frame, x0, size_bounds)
+            # Boxes and ellipsoids fit equally well with any axis as z: a near-tie keeps the
+            # earlier start, so that rounding does not decide which axis is reported as z.
+            if best is None or robust < best[0] * (1.0 - TIE_RTOL):
+                best = (robust, cost, x, frame)
     assert best is not None
     _, cost, x, frame = best
     size, shape, centre = x[0:3], x[3:5], x[5:8]
@@ -227,7 +221,7 @@ def _frames(vt: Array, half: Array) -> list[tuple[Array, Array]]:
 
 
 def _solve(
-    q: Array, frame: Array, x0: Array, size_bounds: tuple[Array, Array], evaluations: int
+    q: Array, frame: Array, x0: Array, size_bounds: tuple[Array, Array]
 ) -> tuple[float, float, Array]:
     """One bounded robust least-squares run from ``x0`` (sizes, shapes, centre, rotation
     vector relative to ``frame``). Returns the robust objective, the plain cost (half the sum
@@ -250,7 +244,7 @@ def _solve(
         x_scale="jac",
         loss="soft_l1",
         f_scale=LOSS_SCALE,
-        max_nfev=evaluations,
+        max_nfev=MAX_EVALUATIONS,
     )
     cost = 0.5 * float(np.sum(done.fun**2))
     return float(done.cost), cost, np.asarray(done.x, dtype=float)
