@@ -12,7 +12,10 @@ Prints:
   of a run's wall time to the time it spent inside mj_step (timed call by call) is measured
   within one span and is the steadiest figure.
   A loop from the scene's rest state, which the robot never disturbs, is printed beside it;
-- the run's real-time factor;
+- the run's real-time factor (goal for pour.dial: >= 20 on one core);
+- for a script in the pour scene, the bare physics of that run per simulated second beside
+  that of the same script in the pour scene as it was before issue 16
+  (benchmarks/pour_before/), each replayed from its own run, and their ratio (target >= 3);
 - the scheduler's cost per event run on the fake robot, beside an equivalent py_trees tree
   (needs the `bench` extra: pip install -e ".[bench]").
 
@@ -22,7 +25,9 @@ Prints:
 from __future__ import annotations
 
 import argparse
+import tempfile
 import time
+from pathlib import Path
 from types import SimpleNamespace
 
 import mujoco
@@ -33,15 +38,17 @@ from dial.backend.model import load_model
 from dial.engine import RunOptions, RunResult, run
 from dial.parser import Script, check_text, load
 from dial.resources import resolve_script
-from dial.scene import load_scene_names
+from dial.scene import World, load_scene_names, worlds_dir
 from dial.testing import run_fake
+
+POUR_BEFORE = Path(__file__).resolve().parent / "pour_before" / "pour_before.toml"
 
 
 class _StepRecorder:
     """Stands in for the driver's ``mujoco`` module: records what each mj_step call got."""
 
     def __init__(self) -> None:
-        self.start: np.ndarray | None = None
+        self.start: mujoco.MjData | None = None
         self.calls: list[tuple[np.ndarray, np.ndarray, int]] = []
 
     def __getattr__(self, name: str) -> object:
@@ -49,11 +56,35 @@ class _StepRecorder:
 
     def mj_step(self, model: mujoco.MjModel, data: mujoco.MjData, nstep: int = 1) -> None:
         if self.start is None:
-            spec = mujoco.mjtState.mjSTATE_INTEGRATION
-            self.start = np.empty(mujoco.mj_stateSize(model, spec))
-            mujoco.mj_getState(model, data, self.start, spec)
+            # The whole MjData, not mj_getState: restoring a state wakes every sleeping body
+            # (MuJoCo 4), and the pour scene starts with its objects asleep.
+            self.start = mujoco.MjData(model)
+            mujoco.mj_copyData(self.start, model, data)
         self.calls.append((data.ctrl.copy(), data.eq_active.copy(), nstep))
         mujoco.mj_step(model, data, nstep=nstep)
+
+
+class _Replay:
+    """A recorded run's physics steps, replayed from its start state on a fresh model."""
+
+    def __init__(self, recorder: _StepRecorder, model_path: Path) -> None:
+        assert recorder.start is not None
+        self.recorder = recorder
+        self.model = load_model(model_path)
+        self.data = mujoco.MjData(self.model)
+        self.steps = sum(nstep for _, _, nstep in recorder.calls)
+        self.sim_time = self.steps * self.model.opt.timestep
+
+    def run(self) -> tuple[float, float]:
+        """Replay once; (wall, process CPU) seconds."""
+        model, data = self.model, self.data
+        mujoco.mj_copyData(data, model, self.recorder.start)
+        t0, c0 = time.perf_counter(), time.process_time()
+        for ctrl, eq_active, nstep in self.recorder.calls:
+            data.ctrl[:] = ctrl
+            data.eq_active[:] = eq_active
+            mujoco.mj_step(model, data, nstep=nstep)
+        return time.perf_counter() - t0, time.process_time() - c0
 
 
 class _StepTimer(SimpleNamespace):
@@ -80,24 +111,22 @@ def _run_with(stand_in: object, script: Script) -> RunResult:
         driver.mujoco = mujoco
 
 
-def engine_overhead(script_arg: str, repeat: int) -> None:
-    script = load(resolve_script(script_arg), load_scene_names)
-    # One recorded run gives the controls to replay; it is not timed (the recorder has its
-    # own cost). Runs are deterministic, so every timed run steps the same physics.
+def _record(script: Script) -> tuple[RunResult, _Replay]:
+    """One run with the step recorder (not timed: the recorder has its own cost)."""
     recorder = _StepRecorder()
     recorded = _run_with(recorder, script)
-    model = load_model(recorded.world.model_path)
-    data = mujoco.MjData(model)
-    assert recorder.start is not None
+    return recorded, _Replay(recorder, recorded.world.model_path)
 
-    def replay() -> tuple[float, float]:
-        mujoco.mj_setState(model, data, recorder.start, mujoco.mjtState.mjSTATE_INTEGRATION)
-        t0, c0 = time.perf_counter(), time.process_time()
-        for ctrl, eq_active, nstep in recorder.calls:
-            data.ctrl[:] = ctrl
-            data.eq_active[:] = eq_active
-            mujoco.mj_step(model, data, nstep=nstep)
-        return time.perf_counter() - t0, time.process_time() - c0
+
+def engine_overhead(script_arg: str | Script, repeat: int) -> tuple[World, _Replay]:
+    """Print the overhead figures; return the run's world and replay. Runs are deterministic,
+    so every timed run steps the same physics as the recorded one."""
+    if isinstance(script_arg, Script):
+        script, script_arg = script_arg, Path(script_arg.path).name
+    else:
+        script = load(resolve_script(script_arg), loader=load_scene_names)
+    _, replay = _record(script)
+    model, data = replay.model, replay.data
 
     # Interleaved pairs, so that a noisy neighbour slows a run and its replay alike.
     walls, replays, cpu_ratios, inside = [], [], [], []
@@ -105,7 +134,7 @@ def engine_overhead(script_arg: str, repeat: int) -> None:
         timer = _StepTimer()
         result = _run_with(timer, script)
         inside.append(result.wall_time / timer.seconds)
-        bare_wall, bare_cpu = replay()
+        bare_wall, bare_cpu = replay.run()
         walls.append(result.wall_time)
         replays.append(bare_wall)
         cpu_ratios.append(result.cpu_time / bare_cpu)
@@ -132,51 +161,141 @@ def engine_overhead(script_arg: str, repeat: int) -> None:
     own = sorted(inside)[len(inside) // 2]
     print(f"  overhead ratio within the run    {own:8.3f}   (wall / time inside mj_step; median)")
     print(f"  overhead ratio vs scene at rest  {wall / idle:8.3f}")
-    print(f"  real-time factor                 {result.summary.sim_time / wall:8.2f}")
+    goal = "   (goal for pour.dial: >= 20 on one core)" if _is_pour(result.world) else ""
+    print(f"  real-time factor                 {result.summary.sim_time / wall:8.2f}{goal}")
     print(f"  task succeeded                   {result.ok}")
+    return result.world, replay
+
+
+def _is_pour(world: World) -> bool:
+    return world.path.resolve() == (worlds_dir() / "pour.toml").resolve()
+
+
+def pour_physics(script_arg: str, today: _Replay, repeat: int) -> None:
+    """Bare physics per simulated second: the same script in the pour scene before issue 16
+    and today, each replaying its own run; interleaved pairs, CPU time."""
+    script = load(resolve_script(script_arg), loader=load_scene_names, scene=str(POUR_BEFORE))
+    recorded, before = _record(script)
+    costs: tuple[list[float], list[float]] = ([], [])
+    for _ in range(repeat):
+        for replay, cost in zip((before, today), costs, strict=True):
+            cost.append(replay.run()[1] / replay.sim_time)
+    ratios = sorted(b / t for b, t in zip(*costs, strict=True))
+    print(f"{script_arg}: bare physics per simulated second, each scene replaying its own run")
+    print(f"  {repeat} interleaved pairs; ratio per pair:", " ".join(f"{r:.2f}" for r in ratios))
+    for name, replay, cost in (("before issue 16", before, costs[0]), ("today", today, costs[1])):
+        ms, steps = min(cost) * 1e3, replay.steps
+        print(f"  {name:<16} {ms:8.1f} ms CPU per simulated s (best; {steps} steps)")
+    print(f"  ratio before / today, median pair {ratios[len(ratios) // 2]:6.2f}   (target >= 3)")
+    print(f"  before: {POUR_BEFORE.parent.name}/ (succeeded: {recorded.ok})")
+
+
+def watched_overhead(repeat: int) -> None:
+    """The overhead with a monitor armed all through pour's long block (it never fires):
+    the driver steps one physics step at a time and tests the condition after each."""
+    text = resolve_script("pour.dial").read_text(encoding="utf-8")
+    lines = text.splitlines()
+    last = max(i for i, line in enumerate(lines) if line.startswith("retract_arm "))
+    width = max(len(line) for line in lines[last - 8 : last + 1])
+    lines.insert(last + 1, "idle" + " " * 8 + "~" * (width - 12))
+    lines.insert(last + 2, "@on idle\n@end")
+    lines.insert(
+        lines.index(next(ln for ln in lines if ln.startswith("% retract_arm"))) + 1,
+        "% idle tactile_contact finger=ring threshold=5mm",
+    )
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / "pour_watched.dial"
+        path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+        script = load(path, loader=load_scene_names)
+        print("watched spans: pour.dial with a monitor armed through its whole block")
+        engine_overhead(script, repeat)
+
+
+def _fake_cost(text: str) -> tuple[float, int]:
+    """Seconds per event run (or event-tick) of ``text`` on the fake robot, unpaced as
+    ``dial run`` runs (the best of three), and the number of event runs."""
+    script = check_text(text, "bench.dial")
+    t0 = time.perf_counter()
+    result = run_fake(script, tick=0.01, period=0.01, paced=False)
+    return time.perf_counter() - t0, result.summary.outcomes["runs"]
+
+
+def _trees_cost(root: object, done: int) -> float:
+    import py_trees
+
+    tree = py_trees.trees.BehaviourTree(root)
+    t0 = time.perf_counter()
+    while tree.root.status != py_trees.common.Status.SUCCESS:
+        tree.tick()
+    return time.perf_counter() - t0
 
 
 def scheduler_cost(runs: int) -> None:
-    # One-tick runs of one control period each: the scheduler's own work dominates.
+    """The runner's own cost on the fake robot beside equivalent py_trees trees (DESIGN 7)."""
     defs = "".join(f'% e{i} hand_pose "p" fingers=0x{1 << (4 * i):04X}\n' for i in range(4))
-    body = "@repeat {}\n{}@end\n".format(runs // 4, "".join(f"e{i} #\n" for i in range(4)))
-    script = check_text(defs + body, "bench.dial")
-    assert script is not None
-    t0 = time.perf_counter()
-    result = run_fake(script, tick=0.01, period=0.01)
-    n = result.summary.outcomes["runs"]
-    dial_cost = (time.perf_counter() - t0) / n
-    print(f"scheduler on the fake robot: {n} event runs of one tick")
-    print(f"  dial                   {dial_cost * 1e6:8.1f} us per event run")
+    # Workload 1: one-tick runs of one control period each: scheduling dominates.
+    one = defs + "@repeat {}\n{}@end\n".format(runs // 4, "".join(f"e{i} #\n" for i in range(4)))
+    # Workload 2: 10 sequential blocks, each with 4 concurrent lanes of 10 ticks.
+    lanes = "".join(f"e{i} #=========\n" for i in range(4))
+    blocks = defs + "@repeat {}\n{}@end\n".format(runs // 40, "\n".join([lanes] * 10))
+    one_s, n1 = _fake_cost(one)
+    blk_s, n2 = _fake_cost(blocks)
+    per_one, per_tick = one_s / n1, blk_s / (n2 * 10)
+    print("scheduler on the fake robot (unpaced, as dial run)")
+    print(f"  one-tick runs:        dial {per_one * 1e6:6.2f} us per event run ({n1} runs)")
+    print(f"  10 blocks x 4 x 10:   dial {per_tick * 1e6:6.2f} us per event-tick ({n2} runs)")
     try:
         import py_trees
     except ImportError:
         print("  py_trees               not installed (pip install -e '.[bench]')")
         return
 
-    class OneTick(py_trees.behaviour.Behaviour):  # type: ignore[misc]
-        """Runs for one tick, like a one-tick dial run."""
+    class Ticks(py_trees.behaviour.Behaviour):  # type: ignore[misc]
+        """Runs for ``n`` ticks, like an n-tick dial run."""
+
+        def __init__(self, name: str, n: int) -> None:
+            super().__init__(name)
+            self.n = n
 
         def initialise(self) -> None:
             self.ticks = 0
 
         def update(self) -> py_trees.common.Status:
             self.ticks += 1
-            if self.ticks > 1:
+            if self.ticks > self.n:
                 return py_trees.common.Status.SUCCESS
             return py_trees.common.Status.RUNNING
 
-    # The same shape as the script: four one-tick events in sequence, repeated.
-    block = py_trees.composites.Sequence("block", memory=True)
-    block.add_children([OneTick(f"e{i}") for i in range(4)])
-    root = py_trees.decorators.Repeat("repeat", block, num_success=n // 4)
-    tree = py_trees.trees.BehaviourTree(root)
-    t0 = time.perf_counter()
-    while tree.root.status != py_trees.common.Status.SUCCESS:
-        tree.tick()
-    trees_cost = (time.perf_counter() - t0) / n
-    print(f"  py_trees               {trees_cost * 1e6:8.1f} us per event run")
-    print(f"  ratio dial / py_trees  {dial_cost / trees_cost:8.2f}")
+    def one_tick_tree() -> object:
+        # The same shape as the script: four one-tick events in sequence, repeated.
+        block = py_trees.composites.Sequence("block", memory=True)
+        block.add_children([Ticks(f"e{i}", 1) for i in range(4)])
+        return py_trees.decorators.Repeat("repeat", block, num_success=n1 // 4)
+
+    def lanes_tree() -> object:
+        # Each block: four 10-tick lanes in parallel; ten blocks in sequence, repeated.
+        seq = py_trees.composites.Sequence("blocks", memory=True)
+        for b in range(10):
+            par = py_trees.composites.Parallel(
+                f"b{b}", policy=py_trees.common.ParallelPolicy.SuccessOnAll()
+            )
+            par.add_children([Ticks(f"e{i}", 10) for i in range(4)])
+            seq.add_child(par)
+        return py_trees.decorators.Repeat("repeat", seq, num_success=n2 // 40)
+
+    # Interleaved pairs, so that a noisy neighbour slows both sides alike; median of ratios.
+    ones, ticks = [], []
+    for _ in range(5):
+        ones.append((_fake_cost(one)[0] / n1, _trees_cost(one_tick_tree(), n1) / n1))
+        ticks.append((_fake_cost(blocks)[0] / (n2 * 10), _trees_cost(lanes_tree(), n2) / (n2 * 10)))
+    for label, pairs in (("one-tick runs", ones), ("10 blocks x 4 x 10", ticks)):
+        ratios = sorted(d / t for d, t in pairs)
+        trees = min(t for _, t in pairs)
+        print(f"  {label + ':':<21} py_trees {trees * 1e6:6.2f} us (best of 5)")
+        print(
+            f"  ratio dial / py_trees, {label:<19} {ratios[2]:6.2f}  (median of 5 pairs; "
+            "at most 0.5, goal 0.2)"
+        )
 
 
 def main() -> None:
@@ -185,7 +304,10 @@ def main() -> None:
     ap.add_argument("--runs", type=int, default=4000, help="event runs for the scheduler cost")
     ap.add_argument("--repeat", type=int, default=5, help="timed pairs of a run and a replay")
     args = ap.parse_args()
-    engine_overhead(args.script, args.repeat)
+    world, replay = engine_overhead(args.script, args.repeat)
+    if _is_pour(world):
+        pour_physics(args.script, replay, args.repeat)
+        watched_overhead(args.repeat)
     scheduler_cost(args.runs)
 
 

@@ -3,15 +3,25 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from itertools import groupby
+from typing import NamedTuple
 
 
 class DialError(Exception):
     """Root of every error the package raises on purpose."""
 
 
-@dataclass(frozen=True, order=True)
-class Span:
-    """A place in a source file: 1-based line and column, ``end_col`` exclusive."""
+class OptionError(DialError):
+    """An option (of ``dial run``, or of :func:`dial.run`) out of its range or unusable:
+    a usage error, exit status 2. The message names the option and what was expected."""
+
+
+class Span(NamedTuple):
+    """A place in a source file: 1-based line and column, ``end_col`` exclusive.
+
+    A named tuple rather than a dataclass: a large script has one per mark, and a tuple is
+    cheap to make. Spans order by line, then column.
+    """
 
     line: int
     col: int
@@ -40,15 +50,45 @@ class Diagnostic:
         return f"{self.path}:{self.span.line}:{self.span.col}: {self.message}"
 
     def render(self) -> str:
-        """``FILE:LINE:COL: message``, then the source line and a caret span."""
+        """``FILE:LINE:COL: message``, then the source line and a caret span.
+
+        A long line is shown as a window of about :data:`WINDOW` characters around the
+        caret, with ``...`` where it is cut.
+        """
         if not self.source_line:
             return self.header
         num = str(self.span.line)
-        text = self.source_line.rstrip("\n").expandtabs(1)
-        width = max(self.span.end_col - self.span.col, 1)
+        text, start, width = _window(self.source_line.rstrip("\n"), self.span)
         pad = " " * len(num)
-        caret = " " * (self.span.col - 1) + "^" * width
+        caret = " " * start + "^" * width
         return f"{self.header}\n {num} | {text}\n {pad} | {caret}"
+
+
+def shorten(text: str, limit: int = 40) -> str:
+    """``text`` for quoting in a message: cut to ``limit`` characters, saying how long it was."""
+    return text if len(text) <= limit else f"{text[:limit]}... ({len(text)} characters)"
+
+
+WINDOW = 100  # characters of a source line shown around a caret
+MAX_SHOWN = 50  # diagnostics rendered per file; the rest are counted
+
+
+def _window(line: str, span: Span) -> tuple[str, int, int]:
+    """The part of ``line`` to show, and where the caret starts in it and how wide it is."""
+    first = max(span.col - 1, 0)
+    width = max(span.end_col - span.col, 1)
+    if len(line) <= WINDOW:
+        return line.expandtabs(1), first, width
+    width = min(width, WINDOW // 2)
+    lo = max(0, min(first - WINDOW // 4, len(line) - WINDOW))
+    hi = min(len(line), lo + WINDOW)
+    text = line[lo:hi].expandtabs(1)
+    start = first - lo
+    if lo > 0:
+        text, start = "..." + text, start + 3
+    if hi < len(line):
+        text += "..."
+    return text, start, width
 
 
 class ScriptError(DialError):
@@ -62,4 +102,12 @@ class ScriptError(DialError):
         super().__init__(self.render())
 
     def render(self) -> str:
-        return "\n".join(d.render() for d in self.diagnostics)
+        """Every diagnostic, at most :data:`MAX_SHOWN` per file, then how many more."""
+        out: list[str] = []
+        for path, group in groupby(self.diagnostics, key=lambda d: d.path):
+            diags = list(group)
+            out += [d.render() for d in diags[:MAX_SHOWN]]
+            more = len(diags) - MAX_SHOWN
+            if more > 0:
+                out.append(f"{path}: {more} more problem{'s' if more != 1 else ''} not shown")
+        return "\n".join(out)

@@ -11,6 +11,8 @@ import math
 import re
 from typing import Literal
 
+from dial.errors import shorten
+
 Dimension = Literal["length", "angle", "force", "time", "speed", "angular_speed"]
 
 UNITS: dict[Dimension, dict[str, float]] = {
@@ -31,7 +33,10 @@ NOUNS: dict[Dimension, str] = {
     "angular_speed": "an angular speed",
 }
 
-_NUMBER = re.compile(r"^([+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?)([A-Za-z/]*)$")
+# ASCII digits only: int() and float() also take other scripts' digits, which a script's
+# reader would not recognise as numbers.
+_NUMBER = re.compile(r"^([+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?)([A-Za-z/]*)$")
+MAX_NUMBER_CHARS = 40  # longer than any number a script needs; keeps messages and parsing small
 
 
 class UnitError(ValueError):
@@ -46,9 +51,9 @@ def expected(dim: Dimension, default_unit: str) -> str:
 
 def parse_number(text: str) -> float:
     """A plain finite number, no unit."""
-    m = _NUMBER.match(text)
+    m = _NUMBER.match(text) if len(text) <= MAX_NUMBER_CHARS else None
     if m is None or m.group(2):
-        raise UnitError(f"expected a number, got '{text}'")
+        raise UnitError(f"expected a number, got '{shorten(text)}'")
     value = float(m.group(1))
     if not math.isfinite(value):
         raise UnitError(f"expected a finite number, got '{text}'")
@@ -57,9 +62,9 @@ def parse_number(text: str) -> float:
 
 def parse_quantity(text: str, dim: Dimension, default_unit: str) -> float:
     """Parse ``text`` as a quantity of ``dim``; return it in SI units."""
-    m = _NUMBER.match(text)
+    m = _NUMBER.match(text) if len(text) <= MAX_NUMBER_CHARS else None
     if m is None:
-        raise UnitError(f"expected {expected(dim, default_unit)}, got '{text}'")
+        raise UnitError(f"expected {expected(dim, default_unit)}, got '{shorten(text)}'")
     number, unit = m.group(1), m.group(2) or default_unit
     scale = UNITS[dim].get(unit)
     if scale is None:

@@ -24,14 +24,14 @@ def test_there_are_enough_golden_files() -> None:
 
 @pytest.mark.parametrize("path", VALID, ids=lambda p: p.stem)
 def test_valid_timeline(path: Path) -> None:
-    script = load(path, load_scene_names, display=path.name)
+    script = load(path, loader=load_scene_names, display=path.name)
     golden(path.with_suffix(".show"), render(script))
 
 
 @pytest.mark.parametrize("path", INVALID, ids=lambda p: p.stem)
 def test_invalid_message(path: Path) -> None:
     with pytest.raises(ScriptError) as info:
-        load(path, load_scene_names, display=path.name)
+        load(path, loader=load_scene_names, display=path.name)
     headers = "".join(d.header + "\n" for d in info.value.diagnostics)
     golden(path.with_suffix(".err"), headers)
     # Every message points into the file it names, with a caret under the span.

@@ -6,9 +6,10 @@ from pathlib import Path
 
 import pytest
 
-from dial.errors import ScriptError
-from dial.parser import TBlock, TCall, TIf, TRepeat, check_text, parse
-from dial.parser.ast import Block
+from dial.errors import ScriptError, Span
+from dial.parser import TBlock, TCall, TIf, TRepeat, check_text, parse, parse_partial
+from dial.parser.ast import Block, Condition
+from dial.parser.script import TAbort, TOn, TResume, TRetry, Watch
 
 HEAD = '% go puma_command "moves above"\n% open hand_pose "open_hand"\n'
 
@@ -88,3 +89,69 @@ def test_program_equality_ignores_spacing() -> None:
 
 def test_crlf_line_endings_parse_like_lf() -> None:
     assert parse(HEAD.replace("\n", "\r\n") + "go #=\r\n") == parse(HEAD + "go #=\n")
+
+
+WATCH_HEAD = (
+    "% down arm_move 0 0 -0.03 frame=world\n"
+    "% up arm_move 0 0 0.01 frame=world\n"
+    "% touch tactile_contact finger=index\n"
+    "% held force_contact finger=thumb\n"
+)
+
+
+def test_watched_spans_compile_to_watches_not_runs() -> None:
+    script = check_text(
+        WATCH_HEAD + "down  #====\ntouch   ~~ ~~~.\nheld  ~\n@on touch\n@end\n@on !held\n@end\n",
+        "w.dial",
+    )
+    block = script.timeline[0]
+    assert isinstance(block, TBlock)
+    assert [r.event for r in block.runs] == ["down"]
+    assert block.watches == (
+        Watch("held", 7, 1, 1),
+        Watch("touch", 6, 3, 4),
+        Watch("touch", 6, 6, 8),
+    )
+    assert block.watches[1].span == Span(6, 9, 11)
+    assert block.length == 9  # the '~' ticks and the trailing '.' count
+    assert [str(r.condition) for r in block.reactions] == ["touch", "!held"]
+    assert "touch" not in script.condition_only and "held" not in script.condition_only
+
+
+def test_reaction_bodies_compile_with_their_endings() -> None:
+    text = WATCH_HEAD + (
+        "down  #====\ntouch ~~~\n"
+        "@on touch\nup    #\nheld  ~\n@on held\n@resume\n@end\n"
+        '@repeat 2\nup #\n@if held\n@abort "slipped  twice"\n@end\n@end\n@retry\n@end\n'
+        "@on !touch\n@retry max 7\n@end\n"
+    )
+    block = check_text(text, "w.dial").timeline[0]
+    assert isinstance(block, TBlock)
+    first, second = block.reactions
+    inner, loop, retry = first.body
+    assert isinstance(inner, TBlock) and inner.watches == (Watch("held", 9, 1, 1),)
+    assert inner.reactions == (TOn(Condition("held", False), (TResume(11),), 10),)
+    assert isinstance(loop, TRepeat) and isinstance(loop.body[1], TIf)
+    assert loop.body[1].then == (TAbort("slipped twice", 16),)
+    assert retry == TRetry(3, 19)
+    assert second == TOn(Condition("touch", True), (TRetry(7, 22),), 21)
+
+
+def test_an_on_may_follow_a_broken_block_without_a_second_error() -> None:
+    text = WATCH_HEAD + "down  #=x\ntouch ~~~\n@on touch\n@end\n"
+    with pytest.raises(ScriptError) as info:
+        check_text(text, "w.dial")
+    assert [d.span.line for d in info.value.diagnostics] == [5]
+    # A broken block inside the first reaction does not make the second one an error.
+    text = WATCH_HEAD + "down  #=x\ntouch ~~~\n@on touch\nup #x\n@end\n@on !touch\n@end\n"
+    with pytest.raises(ScriptError) as info:
+        check_text(text, "w.dial")
+    assert [d.span.line for d in info.value.diagnostics] == [5, 8]
+
+
+def test_a_block_after_a_broken_one_is_still_read() -> None:
+    with pytest.raises(ScriptError) as info:
+        check_text(HEAD + "go #x\n\ngo #\nopen #\n\nopen #\n", "t")
+    assert [d.span.line for d in info.value.diagnostics] == [3]
+    program, _ = parse_partial(HEAD + "go #x\n\ngo #\n// c\nopen #\n\nopen #\n")
+    assert [len(b.lines) for b in program.body if isinstance(b, Block)] == [2, 1]

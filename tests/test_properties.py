@@ -31,7 +31,14 @@ DIRECTIVES = [
     "@end",
     "@tick 0.2",
     "@scene ./nowhere",
+    "@on touch",
+    "@on !touch",
+    "@resume",
+    "@retry",
+    "@retry max 2",
+    '@abort "it  slipped"',
 ]
+ENDINGS = ["", "@resume", "@retry max 4", "@retry", '@abort "lost it"']
 COMMENTS = ["// a comment", "/* one line */", "/* two", "lines */", "//  1234567890", ""]
 
 
@@ -45,17 +52,42 @@ def diagrams(draw: st.DrawFn) -> str:
 
 
 @st.composite
+def watched(draw: st.DrawFn) -> str:
+    out = " " * draw(st.integers(0, 6))
+    for _ in range(draw(st.integers(1, 2))):
+        out += "~" * draw(st.integers(1, 5)) + draw(st.sampled_from(["", " ", ".", " . "]))
+    return out.rstrip()
+
+
+@st.composite
+def reaction(draw: st.DrawFn) -> list[str]:
+    """A block with a watched line, and an ``@on`` for it (sometimes with a nested one)."""
+    gap = " " * draw(st.integers(1, 4))
+    lines = ["go" + gap + draw(diagrams()), "touch" + gap + draw(watched())]
+    lines.append(draw(st.sampled_from(["@on touch", "@on !touch"])))
+    if draw(st.booleans()):
+        lines += ["back " + draw(diagrams())]
+        if draw(st.booleans()):
+            lines += ["touch  " + draw(watched()), "@on !touch", "@resume", "@end"]
+    ending = draw(st.sampled_from(ENDINGS))
+    return [*lines, *([ending] if ending else []), "@end"]
+
+
+@st.composite
 def scripts(draw: st.DrawFn) -> str:
     lines: list[str] = []
     for _ in range(draw(st.integers(1, 14))):
-        kind = draw(st.sampled_from(["def", "exec", "exec", "exec", "dir", "comment"]))
-        if kind == "def":
+        kind = draw(st.sampled_from(["def", "exec", "exec", "exec", "dir", "comment", "react"]))
+        if kind == "react":
+            lines += draw(reaction())
+        elif kind == "def":
             lines.append(draw(st.sampled_from(DEFINITIONS)))
         elif kind == "exec":
             name = draw(st.sampled_from(EVENTS))
             gap = " " * draw(st.integers(1, 8))
             tail = draw(st.sampled_from(["", "", "  // note", " /* c */"]))
-            lines.append(name + gap + draw(diagrams()) + tail)
+            marks = draw(st.one_of(diagrams(), diagrams(), watched()))
+            lines.append(name + gap + marks + tail)
         elif kind == "dir":
             lines.append(draw(st.sampled_from(DIRECTIVES)))
         else:
@@ -63,7 +95,9 @@ def scripts(draw: st.DrawFn) -> str:
     return "\n".join(lines) + "\n"
 
 
-ALPHABET = st.sampled_from([*'#=-. \t\n%@/*"_=!x0aZ:,', "\r\n", "0x", "@end", "é"])
+ALPHABET = st.sampled_from(
+    [*'#=-~. \t\n%@/*"_=!x0aZ:,', "\r\n", "0x", "@end", "@on touch", "@retry", "é"]
+)
 
 
 @st.composite

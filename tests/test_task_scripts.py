@@ -14,7 +14,7 @@ from .conftest import DATA, ROOT, golden
 
 
 def _ranges(name: str) -> list[tuple[str, int, int]]:
-    layout = expand(load(ROOT / "scripts" / name, load_scene_names))
+    layout = expand(load(ROOT / "scripts" / name, loader=load_scene_names))
     return [(p.run.event, p.start, p.hold_end) for p in layout.runs]
 
 

@@ -17,30 +17,15 @@ from dial.backend.snapshot import FloatArray
 from dial.instructions.types import FINGERS
 
 
-def taxel_positions(model: mujoco.MjModel, data: mujoco.MjData, finger: int) -> FloatArray:
-    """(256, 3) world positions (m) of a fingertip's taxels, in sensor order."""
-    sensor = int(
-        mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SENSOR, f"hand_{FINGERS[finger]}_tactile")
-    )
-    # A tactile sensor's object is its mesh; its reference is the geom that carries it.
-    mesh, geom = int(model.sensor_objid[sensor]), int(model.sensor_refid[sensor])
-    adr, n = int(model.mesh_vertadr[mesh]), int(model.mesh_vertnum[mesh])
-    local = model.mesh_vert[adr : adr + n].astype(np.float64)
-    rot = data.geom_xmat[geom].reshape(3, 3)
-    points: FloatArray = data.geom_xpos[geom] + local @ rot.T
-    return points
-
-
-def tactile_point(
-    model: mujoco.MjModel, data: mujoco.MjData, finger: int, depths: FloatArray
-) -> FloatArray | None:
+def tactile_point(depths: FloatArray, taxels: FloatArray) -> FloatArray | None:
     """The depth-weighted centroid (3,) of the taxels that feel something, or None.
 
-    ``depths``: that finger's taxel depths (m), any shape, in sensor order."""
+    ``depths``: a fingertip's taxel depths (m), any shape, in sensor order; ``taxels``:
+    their (256, 3) world positions (``MujocoRobot.taxel_points``)."""
     weights = np.asarray(depths, dtype=np.float64).reshape(-1)
     if weights.max() <= 0.0:
         return None
-    point: FloatArray = (weights @ taxel_positions(model, data, finger)) / weights.sum()
+    point: FloatArray = (weights @ taxels) / weights.sum()
     return point
 
 

@@ -12,6 +12,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Literal
 
+from dial.instructions.limits import drive_problem
 from dial.instructions.scene_names import SceneNames
 from dial.instructions.types import (
     ALL_JOINTS,
@@ -72,6 +73,11 @@ class Instruction:
     positional_counts: tuple[int, ...] = ()
     # Cross-parameter rule: returns a message when the bound arguments do not fit together.
     validate: Callable[[Args], str | None] | None = None
+    # The class that runs it (dial.primitives names each class by this name).
+    primitive: str = ""
+    # For the contact instructions: the contact kind (tactile, force, position) their
+    # condition reads; only these can be watched with '~' (DESIGN 2.7).
+    condition: str | None = None
 
     def spec(self, name: str) -> ParamSpec | None:
         return next((p for p in self.params if p.name == name), None)
@@ -117,6 +123,14 @@ def _guarded(args: Args, scene: SceneNames | None) -> frozenset[str]:
     return _arm(args, scene) if args.get("finger") is None else _finger(args, scene)
 
 
+def _check_puma(args: Args) -> str | None:
+    if args.get("verb") != "drive":
+        return None
+    joint, angle = args["joint"], args["angle"]
+    assert isinstance(joint, int) and isinstance(angle, float)
+    return drive_problem(joint, angle)
+
+
 def _check_guarded(args: Args) -> str | None:
     if all(args[k] == 0.0 for k in ("dx", "dy", "dz")):
         return "guarded_move needs a nonzero direction DX DY DZ"
@@ -143,7 +157,7 @@ _XYZ = tuple(
 
 
 def _sensing(name: str, summary: str) -> Instruction:
-    return Instruction(name, "zero", (), _none, name, summary, sensing=True)
+    return Instruction(name, "zero", (), _none, name, summary, sensing=True, primitive="Get")
 
 
 def _contact(name: str, dim_unit: tuple[str, str], default: float, what: str) -> Instruction:
@@ -157,6 +171,8 @@ def _contact(name: str, dim_unit: tuple[str, str], default: float, what: str) ->
         f"{name} finger=F [threshold=X{unit}] [timeout=S]",
         f"Wait until {what} on the finger passes the threshold.",
         sensing=True,
+        primitive="ContactWait",
+        condition=name.removesuffix("_contact"),
     )
 
 
@@ -194,6 +210,7 @@ INSTRUCTIONS: dict[str, Instruction] = {
             _hand_pose,
             'hand_pose "NAME" [fingers=MASK]',
             "Move the hand to a named pose (GOTO MOVE or TRAJECTORY MOVE).",
+            primitive="HandPose",
         ),
         Instruction(
             "finger_move",
@@ -202,6 +219,7 @@ INSTRUCTIONS: dict[str, Instruction] = {
             _finger,
             "finger_move finger=F DX DY DZ [frame=palm|world]",
             "Move a fingertip along a straight line by IK on the finger's joints.",
+            primitive="FingerMove",
         ),
         Instruction(
             "puma_command",
@@ -212,6 +230,8 @@ INSTRUCTIONS: dict[str, Instruction] = {
             '| "drive J DEG"',
             "Run a VAL-II command or stored program, time-scaled to the run's span.",
             verbs=_PUMA_VERBS,
+            validate=_check_puma,
+            primitive="PumaCommand",
         ),
         Instruction(
             "arm_move",
@@ -228,6 +248,7 @@ INSTRUCTIONS: dict[str, Instruction] = {
             "arm_move DX DY DZ [RX RY RZ] [frame=tool|world]",
             "Relative straight-line Cartesian move of the tool.",
             positional_counts=(3, 6),
+            primitive="ArmMove",
         ),
         _contact("position_contact", ("length", "mm"), 0.003, "the fingertip position error"),
         _contact("force_contact", ("force", "N"), 0.5, "the change in tendon force differential"),
@@ -256,6 +277,7 @@ INSTRUCTIONS: dict[str, Instruction] = {
             _grasp,
             'grasp_force "JMASK_TMASK FORCE" [speed=RAD/S] [timeout=S]',
             "Close masked joints until each tendon-masked joint feels FORCE (GRASP WITH FORCE).",
+            primitive="GraspForce",
         ),
         Instruction(
             "guarded_move",
@@ -281,6 +303,7 @@ INSTRUCTIONS: dict[str, Instruction] = {
             "[press=D] [frame=tool|palm|world] [speed=V] [timeout=S]",
             "Move along a direction until contact is sensed, checked at every physics step.",
             validate=_check_guarded,
+            primitive="GuardedMove",
         ),
         Instruction(
             "limp",
@@ -292,6 +315,7 @@ INSTRUCTIONS: dict[str, Instruction] = {
             _fingers_mask,
             "limp [fingers=MASK] [save=NAME]",
             "Make joints back-drivable; record the reached pose at the end (teaching).",
+            primitive="Limp",
         ),
         Instruction(
             "record_contact",
@@ -316,6 +340,7 @@ INSTRUCTIONS: dict[str, Instruction] = {
             "record_contact finger=F [into=SET] [at=now|stop] [source=tactile|links]",
             "Append where the finger touches (world frame) to a point set.",
             sensing=True,
+            primitive="RecordContact",
         ),
         Instruction(
             "fit_plane",
@@ -325,6 +350,7 @@ INSTRUCTIONS: dict[str, Instruction] = {
             "fit_plane [SET]",
             "Least-squares plane through a point set: normal, residual, extents.",
             sensing=True,
+            primitive="Fit",
         ),
         Instruction(
             "fit_superquadric",
@@ -334,6 +360,17 @@ INSTRUCTIONS: dict[str, Instruction] = {
             "fit_superquadric [SET]",
             "Least-squares superquadric through a point set: size, shape exponents, pose.",
             sensing=True,
+            primitive="Fit",
         ),
     )
 }
+
+
+def contact_condition(instruction: Instruction, args: Args) -> tuple[str, int, float]:
+    """(kind, finger, threshold) of a contact instruction's condition: it holds when the
+    finger's ``kind`` reading reaches the threshold (m or N)."""
+    if instruction.condition is None:
+        raise ValueError(f"{instruction.name} has no contact condition")
+    finger, threshold = args["finger"], args["threshold"]
+    assert isinstance(finger, int) and isinstance(threshold, float)
+    return instruction.condition, finger, threshold

@@ -11,6 +11,8 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from dial.errors import DialError
+
 
 @dataclass(frozen=True)
 class SceneNames:
@@ -26,7 +28,7 @@ class SceneNames:
     programs: frozenset[str] = frozenset()
 
 
-class SceneNotFoundError(LookupError):
+class SceneNotFoundError(DialError, LookupError):
     """The ``@scene`` argument names no bundled scene and no existing path.
 
     The message lists the valid bundled scene names.

@@ -10,6 +10,7 @@ import re
 from dataclasses import dataclass
 from typing import Literal
 
+from dial.errors import shorten
 from dial.units import Dimension, UnitError, expected, format_quantity, parse_number, parse_quantity
 
 FINGERS: tuple[str, ...] = ("index", "middle", "ring", "thumb")
@@ -85,13 +86,14 @@ class Integer(ParamType):
         return int(value)
 
 
-_MASK = re.compile(r"^(0[xX][0-9A-Fa-f_]+|\d+)$")
+_MASK = re.compile(r"^(0[xX][0-9A-Fa-f_]+|[0-9]+)$")  # ASCII digits only
+MAX_MASK_CHARS = 24  # 0x plus 16 bits in hex with underscores, or decimal, with room
 
 
 def parse_mask(text: str) -> int:
     """A 16-bit joint mask, hex (``0x0666``) or decimal; never empty."""
-    if not _MASK.match(text):
-        raise ParamError(f"expected a 16-bit joint mask such as 0x0666, got '{text}'")
+    if len(text) > MAX_MASK_CHARS or not _MASK.match(text):
+        raise ParamError(f"expected a 16-bit joint mask such as 0x0666, got '{shorten(text)}'")
     digits = text.replace("_", "")
     hexa = digits[:2] in ("0x", "0X")
     if hexa and len(digits) == 2:  # only underscores after 0x

@@ -3,9 +3,10 @@
 This package imports neither MuJoCo nor trio.
 """
 
-from dial.parser.check import EventDef, Script, check_text, load
+from dial.parser.check import check_text, load
 from dial.parser.parse import parse, parse_partial
-from dial.parser.timeline import Run, Step, TBlock, TCall, TIf, TRepeat, expand
+from dial.parser.script import EventDef, Run, Script, Step, TBlock, TCall, TIf, TRepeat
+from dial.parser.timeline import expand
 
 __all__ = [
     "EventDef",

@@ -7,14 +7,14 @@ program written with different spacing (``parse(fmt(x)) == parse(x)``).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Literal
+from typing import Literal, NamedTuple
 
 from dial.errors import Span
 
 _NOSPAN = Span(0, 0, 0)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class Word:
     """One whitespace-separated word of a parameter."""
 
@@ -22,7 +22,7 @@ class Word:
     span: Span = field(default=_NOSPAN, compare=False)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class Param:
     """A parameter as written: a bare word, a quoted group, or ``key=value``.
 
@@ -42,7 +42,7 @@ class Param:
         return f"{self.key}={body}" if self.key is not None else body
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class Definition:
     """``% EVENT INSTRUCTION [PARAMS]``."""
 
@@ -55,32 +55,48 @@ class Definition:
     broken: bool = field(default=False, compare=False)  # its parameters did not tokenize
 
 
-@dataclass(frozen=True)
-class RunMark:
+class RunMark(NamedTuple):
     """One run drawn on an execution line, in block ticks (1-based, inclusive).
 
     ``exec_end`` is the last ``#``/``=`` tick and ``hold_end`` the last tick
-    including ``-`` (equal to ``exec_end`` when there is no hold).
+    including ``-`` (equal to ``exec_end`` when there is no hold). Its place in the
+    text is :meth:`ExecLine.span_of`.
     """
 
     start: int
     exec_end: int
     hold_end: int
-    span: Span = field(default=_NOSPAN, compare=False)
 
 
-@dataclass(frozen=True)
+class WatchMark(NamedTuple):
+    """A watched span ``~~~`` on an execution line, in block ticks (1-based, inclusive)."""
+
+    start: int
+    end: int
+
+
+@dataclass(frozen=True, slots=True)
 class ExecLine:
-    """An execution line: an event name and its diagram."""
+    """An execution line: an event name and its diagram (runs, or watched spans)."""
 
     event: str
     runs: tuple[RunMark, ...]
-    last_tick: int  # rightmost non-space diagram tick, counting '.'
+    last_tick: int  # rightmost non-space diagram tick, counting '.' and '~'
     line: int = field(default=0, compare=False)
-    event_span: Span = field(default=_NOSPAN, compare=False)
+    watches: tuple[WatchMark, ...] = ()
+    column: int = field(default=1, compare=False)  # the text column of the block's tick 1
+
+    def span_of(self, first: int, last: int) -> Span:
+        """Where block ticks ``first..last`` are drawn on this line."""
+        return Span(self.line, first + self.column - 1, last + self.column)
+
+    @property
+    def event_span(self) -> Span:
+        """The event name, in column 1."""
+        return Span(self.line, 1, len(self.event) + 1)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class Condition:
     """``EVENT`` or ``!EVENT``: whether the latest run of EVENT ended ``done``."""
 
@@ -92,16 +108,22 @@ class Condition:
         return ("!" if self.negated else "") + self.event
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class Block:
-    """Consecutive execution lines sharing one tick axis."""
+    """Consecutive execution lines sharing one tick axis, and the reactions to its monitors."""
 
     lines: tuple[ExecLine, ...]
     length: int
     line: int = field(default=0, compare=False)
+    reactions: tuple[On, ...] = ()
+
+    @property
+    def watched(self) -> tuple[str, ...]:
+        """The events watched in this block, in line order, each once."""
+        return tuple(dict.fromkeys(ln.event for ln in self.lines if ln.watches))
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class Repeat:
     """``@repeat N`` (kind ``count``) or ``@repeat until/while COND [max N]``."""
 
@@ -113,7 +135,7 @@ class Repeat:
     span: Span = field(default=_NOSPAN, compare=False)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class If:
     """``@if COND`` ... [``@else`` ...] ``@end``."""
 
@@ -123,19 +145,53 @@ class If:
     line: int = field(default=0, compare=False)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class Call:
     """``@call FILE.dial``; ``target`` is the path as written."""
 
     target: str
     line: int = field(default=0, compare=False)
     span: Span = field(default=_NOSPAN, compare=False)
+    depth: int = field(default=0, compare=False)  # its nesting level, counting callers' calls
 
 
-Statement = Block | Repeat | If | Call
+@dataclass(frozen=True, slots=True)
+class On:
+    """``@on COND`` ... ``@end`` after a block: the reaction when a monitor fires."""
+
+    condition: Condition
+    body: tuple[Statement, ...]
+    line: int = field(default=0, compare=False)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
+class Resume:
+    """``@resume``: go on after the interrupted block."""
+
+    line: int = field(default=0, compare=False)
+
+
+@dataclass(frozen=True, slots=True)
+class Retry:
+    """``@retry [max N]``: run the interrupted block again, at most ``max`` times."""
+
+    max: int
+    line: int = field(default=0, compare=False)
+
+
+@dataclass(frozen=True, slots=True)
+class Abort:
+    """``@abort "MESSAGE"``: end the run with an error naming the monitor."""
+
+    message: str
+    line: int = field(default=0, compare=False)
+
+
+Ending = Resume | Retry | Abort
+Statement = Block | Repeat | If | Call | Resume | Retry | Abort
+
+
+@dataclass(frozen=True, slots=True)
 class Setting:
     """A top-level ``@scene`` or ``@tick`` value as written."""
 
@@ -144,7 +200,7 @@ class Setting:
     span: Span = field(default=_NOSPAN, compare=False)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class Program:
     """A parsed script: its settings, definitions and execution part."""
 

@@ -30,19 +30,48 @@ def _parse(spec: ParamSpec, word: Word, errors: list[tuple[Span, str]]) -> objec
 def bind(instr: Instruction, defn: Definition) -> tuple[Bound, list[tuple[Span, str]]]:
     """Bind ``defn``'s parameters; return the arguments and any problems."""
     errors: list[tuple[Span, str]] = []
-    args: dict[str, object] = {}
-    spans: dict[str, Span] = {}
+    bound = Bound({}, {})
+    specs = _positional(instr, defn, bound, errors)
+    if specs is None:
+        return bound, errors
+    _keyed(instr, defn, bound, errors)
+    args = bound.args
+    for spec in specs if instr.verbs else instr.params:
+        if spec.name in args:
+            continue
+        if spec.required:
+            how = spec.name if spec.positional or instr.verbs else f"{spec.name}="
+            errors.append(
+                (
+                    defn.instruction_span,
+                    f"{instr.name} is missing {how} ({spec.type.expected}); usage: {instr.usage}",
+                )
+            )
+        else:
+            args[spec.name] = spec.default
+    if not errors and instr.validate is not None:
+        message = instr.validate(args)
+        if message:
+            errors.append((defn.instruction_span, message))
+    return bound, errors
+
+
+def _positional(
+    instr: Instruction, defn: Definition, bound: Bound, errors: list[tuple[Span, str]]
+) -> tuple[ParamSpec, ...] | None:
+    """Bind the positional words (after a verb, for verb-style instructions); return the
+    specs that apply, or None if the verb is missing or bad."""
     usage = f"usage: {instr.usage}"
     words = [w for p in defn.params if p.key is None for w in p.words]
     specs: tuple[ParamSpec, ...]
     if instr.verbs:
         if not words:
             errors.append((defn.instruction_span, f"{instr.name} needs a command; {usage}"))
-            return Bound(args, spans), errors
+            return None
         verb = _parse(instr.params[0], words[0], errors)
         if verb is None:
-            return Bound(args, spans), errors
-        args["verb"], spans["verb"] = verb, words[0].span
+            return None
+        bound.args["verb"], bound.spans["verb"] = verb, words[0].span
         specs, words = instr.verbs[str(verb)], words[1:]
     else:
         specs = tuple(p for p in instr.params if p.positional)
@@ -54,7 +83,14 @@ def bind(instr: Instruction, defn: Definition) -> tuple[Bound, list[tuple[Span, 
         where = words[0].span.to(words[-1].span) if words else defn.instruction_span
         errors.append((where, f"{instr.name} takes {counts} numbers, got {len(words)}; {usage}"))
     for spec, word in zip(specs, words, strict=False):
-        args[spec.name], spans[spec.name] = _parse(spec, word, errors), word.span
+        bound.args[spec.name], bound.spans[spec.name] = _parse(spec, word, errors), word.span
+    return specs
+
+
+def _keyed(
+    instr: Instruction, defn: Definition, bound: Bound, errors: list[tuple[Span, str]]
+) -> None:
+    """Bind the ``key=value`` parameters."""
     for p in defn.params:
         if p.key is None:
             continue
@@ -66,28 +102,10 @@ def bind(instr: Instruction, defn: Definition) -> tuple[Bound, list[tuple[Span, 
             valid = f" (valid: {', '.join(names)})" if names else ""
             errors.append((p.span, f"unknown parameter '{p.key}' for {instr.name}{hint}{valid}"))
             continue
-        if p.key in spans:
+        if p.key in bound.spans:
             errors.append((p.span, f"parameter '{p.key}' is given twice"))
             continue
         if len(p.words) != 1:
             errors.append((p.span, f"'{p.key}' takes one value: expected {keyed.type.expected}"))
             continue
-        args[p.key], spans[p.key] = _parse(keyed, p.words[0], errors), p.words[0].span
-    for spec in specs if instr.verbs else instr.params:
-        if spec.name in args:
-            continue
-        if spec.required:
-            how = spec.name if spec.positional or instr.verbs else f"{spec.name}="
-            errors.append(
-                (
-                    defn.instruction_span,
-                    f"{instr.name} is missing {how} ({spec.type.expected}); {usage}",
-                )
-            )
-        else:
-            args[spec.name] = spec.default
-    if not errors and instr.validate is not None:
-        message = instr.validate(args)
-        if message:
-            errors.append((defn.instruction_span, message))
-    return Bound(args, spans), errors
+        bound.args[p.key], bound.spans[p.key] = _parse(keyed, p.words[0], errors), p.words[0].span

@@ -1,56 +1,33 @@
-"""Check a parsed program against the instruction catalogue and compile its timeline.
+"""Check a parsed program: bind its events, look up scene names, check conditions and calls.
 
 Everything here is known without the simulator. Checks that need a scene's
 world file (unknown pose, location or program) go through a
-:data:`~dial.instructions.scene_names.SceneLoader`.
+:data:`~dial.instructions.scene_names.SceneLoader`. The timeline is compiled by
+:mod:`dial.parser.compile`, which asks this checker about names.
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-from dataclasses import dataclass
+import gc
+from collections.abc import Iterator, Mapping
+from contextlib import contextmanager
+from dataclasses import dataclass, field, replace
 from difflib import get_close_matches
 from pathlib import Path
-from typing import Any
 
 from dial.errors import Diagnostic, ScriptError, Span
 from dial.instructions.catalogue import INSTRUCTIONS, Instruction
 from dial.instructions.scene_names import SceneLoader, SceneNames, SceneNotFoundError
-from dial.instructions.types import FINGERS, Name
-from dial.parser.ast import Block, Call, Condition, Definition, If, Program, Repeat, Statement
+from dial.instructions.types import EFFECTORS, Name
+from dial.parser.ast import Call, Condition, Definition, ExecLine, Program
 from dial.parser.bind import bind
+from dial.parser.compile import compile_body, diagram_events
 from dial.parser.parse import parse_partial
-from dial.parser.timeline import Run, Step, TBlock, TCall, TIf, TRepeat
+from dial.parser.script import EventDef, Script
 
-
-@dataclass(frozen=True)
-class EventDef:
-    """A defined event bound to its instruction."""
-
-    name: str
-    instruction: Instruction
-    args: Mapping[str, Any]  # bound values, SI units
-    effectors: frozenset[str]
-    definition: Definition
-
-
-@dataclass(frozen=True)
-class Script:
-    """A checked script: its program, bound events and compiled timeline."""
-
-    path: str
-    program: Program
-    events: Mapping[str, EventDef]
-    condition_only: frozenset[str]
-    timeline: tuple[Step, ...]
-    scene: SceneNames | None
-    # ``dial run --scene``: the scene that replaces ``@scene`` here and in every called script
-    # (an absolute path or a bundled name), or None to use ``@scene``.
-    scene_override: str | None = None
-
-    @property
-    def tick(self) -> float | None:
-        return self.program.tick
+# The instructions whose condition holds or not at each moment, so that a monitor can sense
+# it every control period: the contact conditions (DESIGN 2.7).
+WATCHABLE = tuple(name for name, i in INSTRUCTIONS.items() if i.condition is not None)
 
 
 def _hint(name: str, valid: list[str]) -> str:
@@ -66,48 +43,60 @@ class _SceneFailed:
     """The caller's scene did not load (its error is reported): check no names in callees."""
 
 
-SCENE_FAILED = _SceneFailed()
-CallerScene = SceneNames | _SceneFailed | None
+_SCENE_FAILED = _SceneFailed()
+_CallerScene = SceneNames | _SceneFailed | None
+
+
+@dataclass(frozen=True)
+class _Context:
+    """What a check shares with the checks of the scripts it calls."""
+
+    loader: SceneLoader | None
+    scene_override: str | None  # replaces ``@scene`` here and in every called script
+    diags: list[Diagnostic] = field(default_factory=list)
+    stack: tuple[str, ...] = ()  # resolved paths of the calling scripts, for call cycles
+    # The scene of the calling script: a called script runs in its caller's scene.
+    caller_scene: _CallerScene = None
+    depth: int = 0  # the nesting level of the '@call' that runs this script
+    # Checked callees by (path, id of the scene they run in, level): the script (None if it
+    # has problems), and the scene, kept alive so that its id stays its own.
+    callees: dict[tuple[str, int, int], tuple[Script | None, _CallerScene]] = field(
+        default_factory=dict
+    )
+
+    def entering(self, origin: Path) -> _Context:
+        """The context inside the script at ``origin``."""
+        return replace(self, stack=(*self.stack, str(origin.resolve())))
 
 
 class _Checker:
-    def __init__(
-        self,
-        program: Program,
-        source: str,
-        loader: SceneLoader | None,
-        stack: tuple[str, ...],
-        diags: list[Diagnostic],
-        origin: Path,
-        scene_override: str | None,
-        caller_scene: CallerScene = None,
-    ) -> None:
+    def __init__(self, program: Program, source: str, origin: Path, ctx: _Context) -> None:
         self.program = program
-        self.scene_override = scene_override
-        self.caller_scene = caller_scene  # a called script runs in its caller's scene
+        self.ctx = ctx
         self.origin = origin  # the real file, for resolving @call and @scene paths
-        self.lines = source.split("\n")
-        self.loader = loader
-        self.stack = stack
-        self.diags = diags
+        self.source = source
+        self.lines: list[str] | None = None  # split on the first problem: most checks have none
         self.events: dict[str, EventDef] = {}
         self.broken: set[str] = set()  # defined, but the definition has errors
+        self.shown: set[str] = set()  # events that appear in a diagram
         self.scene: SceneNames | None = None
         self.scene_failed = False
 
-    def error(self, span: Span, message: str, path: str | None = None) -> None:
+    def error(self, span: Span, message: str) -> None:
+        if self.lines is None:
+            self.lines = self.source.split("\n")
         text = self.lines[span.line - 1] if 0 < span.line <= len(self.lines) else ""
-        self.diags.append(Diagnostic(path or self.program.path, span, message, text))
+        self.ctx.diags.append(Diagnostic(self.program.path, span, message, text))
 
     def run(self) -> Script:
         self.load_scene()
         for d in self.program.definitions:
             self.define(d)
-        shown = self.diagram_events(self.program.body)
+        self.shown = diagram_events(self.program.body)
         condition_only = frozenset(
-            e for e in self.events if e not in shown and self.events[e].instruction.sensing
+            e for e in self.events if e not in self.shown and self.events[e].instruction.sensing
         )
-        timeline = self.compile(self.program.body, shown)
+        timeline = compile_body(self.program.body, self)
         return Script(
             self.program.path,
             self.program,
@@ -115,30 +104,34 @@ class _Checker:
             condition_only,
             timeline,
             self.scene,
-            self.scene_override,
+            self.ctx.scene_override,
         )
 
     def load_scene(self) -> None:
-        if isinstance(self.caller_scene, _SceneFailed):
+        caller, override = self.ctx.caller_scene, self.ctx.scene_override
+        if isinstance(caller, _SceneFailed):
             self.scene_failed = True
             return
-        if self.caller_scene is not None:
-            self.scene = self.caller_scene
+        if caller is not None:
+            self.scene = caller
             return
         setting = self.program.scene
-        text = self.scene_override or (setting.text if setting is not None else None)
-        if text is None or self.loader is None:
+        text = override or (setting.text if setting is not None else None)
+        if text is None or self.ctx.loader is None:
             return
         # An overriding scene has no place in the script: its problems point at line 1.
-        span = setting.span if setting is not None and not self.scene_override else Span.at(1, 1)
+        span = setting.span if setting is not None and not override else Span.at(1, 1)
         try:
-            self.scene = self.loader(text, self.origin.parent)
+            self.scene = self.ctx.loader(text, self.origin.parent)
         except SceneNotFoundError as e:
             self.scene_failed = True
             self.error(span, str(e))
         except ValueError as e:
             self.scene_failed = True
             self.error(span, f"scene '{text}' has a bad world file: {e}")
+        except OSError as e:  # a name the file system refuses
+            self.scene_failed = True
+            self.error(span, f"cannot read scene '{text}': {_reason(e)}")
 
     def define(self, d: Definition) -> None:
         if d.broken:  # its syntax error is reported already
@@ -201,27 +194,50 @@ class _Checker:
         own, caller = self.program.scene, self.scene
         if caller is None or own is None or Path(own.text).stem == caller.name:
             return ""
-        if self.scene_override is not None:
+        if self.ctx.scene_override is not None:
             return f" (--scene replaces this script's own '@scene {own.text}')"
-        if isinstance(self.caller_scene, SceneNames):
+        if isinstance(self.ctx.caller_scene, SceneNames):
             return (
                 f", the caller's scene (this script's own '@scene {own.text}' applies only "
                 "when it runs by itself)"
             )
         return ""
 
-    def diagram_events(self, body: tuple[Statement, ...]) -> set[str]:
-        names: set[str] = set()
-        for stmt in body:
-            if isinstance(stmt, Block):
-                names.update(line.event for line in stmt.lines)
-            elif isinstance(stmt, Repeat):
-                names |= self.diagram_events(stmt.body)
-            elif isinstance(stmt, If):
-                names |= self.diagram_events(stmt.then) | self.diagram_events(stmt.orelse)
-        return names
+    def event(self, line: ExecLine) -> EventDef | None:
+        event = self.events.get(line.event)
+        if event is None and line.event not in self.broken:
+            valid = list(self.events)
+            hint = _hint(line.event, valid)
+            define = f"define it with '% {line.event} INSTRUCTION ...'"
+            self.error(
+                line.event_span,
+                f"unknown event '{line.event}'"
+                + (f"{hint} (or {define})" if hint else f": {define}"),
+            )
+        return event
 
-    def condition(self, cond: Condition | None, shown: set[str]) -> None:
+    def watched(self, line: ExecLine) -> bool:
+        event = self.events[line.event]
+        instr = event.instruction
+        if event.effectors or not instr.sensing:
+            what = ", ".join(e for e in EFFECTORS if e in event.effectors) or "an effector"
+            self.error(
+                line.span_of(*line.watches[0]),
+                f"event '{line.event}' cannot be watched: '~' marks a sensing event, and "
+                f"'{line.event}' ({instr.name}) commands {what}",
+            )
+            return False
+        if instr.condition is None:
+            self.error(
+                line.span_of(*line.watches[0]),
+                f"event '{line.event}' ({instr.name}) cannot be watched: only "
+                f"{', '.join(WATCHABLE[:-1])} and {WATCHABLE[-1]} can, because only a contact "
+                "condition holds or not at each moment",
+            )
+            return False
+        return True
+
+    def condition(self, cond: Condition | None) -> None:
         if cond is None or cond.event in self.broken:
             return
         event = self.events.get(cond.event)
@@ -231,7 +247,7 @@ class _Checker:
                 cond.span,
                 f"condition event '{cond.event}' is never defined{_hint(cond.event, valid)}",
             )
-        elif cond.event not in shown and not event.instruction.sensing:
+        elif cond.event not in self.shown and not event.instruction.sensing:
             self.error(
                 cond.span,
                 f"condition-only event '{cond.event}' must be a sensing instruction "
@@ -239,169 +255,125 @@ class _Checker:
                 "or run it in a diagram before testing it",
             )
 
-    def compile(self, body: tuple[Statement, ...], shown: set[str]) -> tuple[Step, ...]:
-        steps: list[Step] = []
-        for stmt in body:
-            if isinstance(stmt, Block):
-                steps.append(self.block(stmt))
-            elif isinstance(stmt, Repeat):
-                self.condition(stmt.condition, shown)
-                inner = self.compile(stmt.body, shown)
-                steps.append(TRepeat(stmt.kind, stmt.count, stmt.condition, inner, stmt.line))
-            elif isinstance(stmt, If):
-                self.condition(stmt.condition, shown)
-                then, orelse = self.compile(stmt.then, shown), self.compile(stmt.orelse, shown)
-                steps.append(TIf(stmt.condition, then, orelse, stmt.line))
-            else:
-                callee = self.call(stmt)
-                if callee is not None:
-                    steps.append(TCall(stmt.target, callee, stmt.line))
-        return tuple(steps)
-
-    def block(self, block: Block) -> TBlock:
-        runs: list[Run] = []
-        for line in block.lines:
-            event = self.events.get(line.event)
-            if event is None:
-                if line.event not in self.broken:
-                    valid = list(self.events)
-                    hint = _hint(line.event, valid)
-                    define = f"define it with '% {line.event} INSTRUCTION ...'"
-                    self.error(
-                        line.event_span,
-                        f"unknown event '{line.event}'"
-                        + (f"{hint} (or {define})" if hint else f": {define}"),
-                    )
-                continue
-            for mark in line.runs:
-                runs.append(
-                    Run(
-                        line.event,
-                        line.line,
-                        mark.start,
-                        mark.exec_end,
-                        mark.hold_end,
-                        event.effectors,
-                        mark.span,
-                    )
-                )
-        runs.sort(key=lambda r: (r.start, r.line))
-        self.conflicts(runs)
-        return TBlock(block.line, block.length, tuple(runs))
-
-    def conflicts(self, runs: list[Run]) -> None:
-        reported: set[tuple[int, int]] = set()
-        for i, a in enumerate(runs):
-            for b in runs[i + 1 :]:
-                if b.start > a.hold_end:
-                    break  # sorted by start: no later run overlaps a
-                first, last = max(a.start, b.start), min(a.hold_end, b.hold_end)
-                key = (a.line, b.line)
-                if first > last or key in reported:
-                    continue
-                shared = a.effectors & b.effectors
-                ticks = f"tick {first}" if first == last else f"ticks {first}-{last}"
-                if a.event == b.event and a.line != b.line:
-                    reported.add(key)
-                    self.error(
-                        b.span,
-                        f"event '{b.event}' (line {b.line}) overlaps its own run on line "
-                        f"{a.line} in {ticks}",
-                    )
-                elif shared:
-                    reported.add(key)
-                    names = ", ".join(e for e in ("arm", *FINGERS) if e in shared)
-                    self.error(
-                        b.span,
-                        f"effector conflict: '{b.event}' (line {b.line}) and '{a.event}' "
-                        f"(line {a.line}) both command {names} in {ticks}",
-                    )
-
     def call(self, stmt: Call) -> Script | None:
-        target = (self.origin.parent / stmt.target).resolve()
-        if not target.is_file():
+        try:
+            target = (self.origin.parent / stmt.target).resolve()
+            found = target.is_file()
+        except (OSError, ValueError) as e:  # a name the file system refuses
+            self.error(stmt.span, f"cannot read called script '{stmt.target}': {_reason(e)}")
+            return None
+        if not found:
             here = Path(self.program.path).parent
             self.error(stmt.span, f"cannot find called script '{stmt.target}' (looked in {here})")
             return None
         key = str(target)
-        if key in self.stack:
-            chain = " -> ".join(Path(p).name for p in (*self.stack, key))
+        if key in self.ctx.stack:
+            chain = " -> ".join(Path(p).name for p in (*self.ctx.stack, key))
             self.error(stmt.span, f"call cycle: {chain}")
             return None
-        before = len(self.diags)
-        display = str(Path(self.program.path).parent / stmt.target)
-        inherited: CallerScene = SCENE_FAILED if self.scene_failed else self.scene
-        callee = check_file(
-            target, self.loader, self.stack, self.diags, display, self.scene_override, inherited
-        )
-        if callee is None or len(self.diags) > before:
-            return None
-        return callee
+        inherited: _CallerScene = _SCENE_FAILED if self.scene_failed else self.scene
+        # A script called many times (or from many callers) is checked once per scene and
+        # level: a chain of scripts that each call the next twice stays linear.
+        memo = (key, id(inherited), stmt.depth)
+        if memo not in self.ctx.callees:
+            before = len(self.ctx.diags)
+            display = str(Path(self.program.path).parent / stmt.target)
+            ctx = replace(self.ctx, caller_scene=inherited, depth=stmt.depth)
+            callee: Script | None = None
+            try:
+                callee = _check_file(target, display, ctx)
+            except OSError as e:
+                self.error(stmt.span, f"cannot read called script '{stmt.target}': {_reason(e)}")
+            ok = callee is not None and len(self.ctx.diags) == before
+            self.ctx.callees[memo] = (callee, inherited) if ok else (None, inherited)
+        return self.ctx.callees[memo][0]
 
 
-def check_text(
-    text: str,
-    path: str,
-    loader: SceneLoader | None = None,
-    stack: tuple[str, ...] = (),
-    diags: list[Diagnostic] | None = None,
-    origin: Path | None = None,
-    scene: str | None = None,
-    caller_scene: CallerScene = None,
-) -> Script | None:
-    """Parse and check ``text``; append problems to ``diags`` (raise if ``diags`` is None).
+def _reason(e: OSError | ValueError) -> str:
+    if isinstance(e, OSError) and e.strerror:
+        return e.strerror
+    return str(e)
 
-    ``path`` is how messages name the file; ``origin`` is the real file that
-    ``@call`` and ``@scene`` paths are relative to (default: ``path``). ``scene``, if
-    given, replaces the ``@scene`` of this script and of every script it calls.
-    ``caller_scene`` is the scene of the script that calls this one, if any: a called
-    script's names are checked against it, whatever its own ``@scene`` says
-    (:data:`SCENE_FAILED`: the caller's scene did not load, so no names are checked).
+
+def _check(text: str, path: str, origin: Path, ctx: _Context) -> Script:
+    """Parse and check ``text``, appending its problems to ``ctx.diags``.
+
+    ``path`` is how messages name the file; ``origin`` is the real file that ``@call``
+    and ``@scene`` paths are relative to.
     """
-    own = diags is None
-    sink: list[Diagnostic] = [] if diags is None else diags
-    program, syntax = parse_partial(text, path)
-    sink.extend(syntax)
-    origin = Path(path) if origin is None else origin
-    resolved = str(origin.resolve())
-    script = _Checker(
-        program, text, loader, (*stack, resolved), sink, origin, scene, caller_scene
-    ).run()
-    if own and sink:
-        raise ScriptError(sink)
+    program, syntax = parse_partial(text, path, depth=ctx.depth)
+    ctx.diags.extend(syntax)
+    return _Checker(program, text, origin, ctx.entering(origin)).run()
+
+
+def _check_file(path: Path, display: str, ctx: _Context) -> Script:
+    raw = path.read_bytes()
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as e:  # say where, then check the rest as well as it reads
+        text = raw.decode("utf-8", errors="replace")
+        start = raw.rfind(b"\n", 0, e.start) + 1
+        line = raw.count(b"\n", 0, e.start) + 1
+        col = len(raw[start : e.start].decode("utf-8", errors="replace")) + 1
+        source = text.split("\n")[line - 1]
+        message = f"not UTF-8 text (byte 0x{raw[e.start]:02X}); dial scripts are UTF-8"
+        ctx.diags.append(Diagnostic(display, Span.at(line, col), message, source))
+    return _check(text, display, path, ctx)
+
+
+@contextmanager
+def _no_gc() -> Iterator[None]:
+    """Pause the cyclic garbage collector: a script's tree holds no cycles, and on a large
+    script its collections would make the check's cost grow faster than its size.
+
+    Afterwards, freezing and at once unfreezing moves what the check made into the oldest
+    generation without a pass over it (a young-generation pass over a large script's tree
+    costs a fifth of its check); it stays collectable there, as any long-lived data.
+    """
+    enabled = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        gc.freeze()
+        gc.unfreeze()
+        if enabled:
+            gc.enable()
+
+
+def _finish(script: Script, ctx: _Context) -> Script:
+    if ctx.diags:
+        raise ScriptError(ctx.diags)
     return script
 
 
-def check_file(
-    path: Path,
-    loader: SceneLoader | None = None,
-    stack: tuple[str, ...] = (),
-    diags: list[Diagnostic] | None = None,
-    display: str | None = None,
-    scene: str | None = None,
-    caller_scene: CallerScene = None,
-) -> Script | None:
-    """Read, parse and check the script at ``path`` (``display`` is how errors name it)."""
-    text = Path(path).read_text(encoding="utf-8", errors="replace")
-    return check_text(
-        text, display or str(path), loader, stack, diags, Path(path), scene, caller_scene
-    )
+def check_text(
+    text: str, path: str, *, loader: SceneLoader | None = None, scene: str | None = None
+) -> Script:
+    """Parse and check ``text``; raise :class:`ScriptError` listing every problem.
+
+    ``path`` names the file in messages, and ``@call`` and ``@scene`` paths are relative
+    to it. ``loader`` looks up the names of ``@scene`` (without one, no names are checked).
+    ``scene`` (a path or a bundled scene name) replaces the script's ``@scene``, and that
+    of every script it calls.
+    """
+    ctx = _Context(loader, scene)
+    with _no_gc():
+        return _finish(_check(text, path, Path(path), ctx), ctx)
 
 
 def load(
     path: str | Path,
+    *,
+    scene: str | None = None,
     loader: SceneLoader | None = None,
     display: str | None = None,
-    scene: str | None = None,
 ) -> Script:
-    """Parse and check a script file; raise :class:`ScriptError` listing every problem.
+    """Read, parse and check a script file; raise :class:`ScriptError` listing every problem.
 
-    ``scene`` (a path or a bundled scene name) replaces the script's ``@scene``, and that of
-    every script it calls.
+    ``display`` is how messages name the file (default: ``path``); ``scene`` and
+    ``loader`` are as for :func:`check_text`.
     """
-    diags: list[Diagnostic] = []
-    script = check_file(Path(path), loader, (), diags, display, scene)
-    if diags:
-        raise ScriptError(diags)
-    assert script is not None
-    return script
+    ctx = _Context(loader, scene)
+    with _no_gc():
+        return _finish(_check_file(Path(path), display or str(path), ctx), ctx)

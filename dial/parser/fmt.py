@@ -14,7 +14,9 @@ from dial.parser.parse import NAME, parse_partial
 from dial.parser.source import Kind, Line, scan
 from dial.parser.words import WordError, tokenize
 
-_RULER = re.compile(r"^(\s*(?://|/\*))( *)([0-9][0-9 ]*?)( *(?:\*/)?\s*)$")
+# A tick ruler comment ("//  1234567890"): opener, padding, digits, closer. No two parts can
+# take the same characters, so a long line that is no ruler fails in linear time.
+_RULER = re.compile(r"^(\s*+(?://|/\*))( *+)([0-9](?:[0-9 ]*[0-9])?)( *+(?:\*/)?\s*+)$")
 
 
 def _tail(ln: Line) -> str:

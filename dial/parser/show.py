@@ -6,8 +6,8 @@ A pure function from a checked script to text.
 from __future__ import annotations
 
 from dial.instructions.types import EFFECTORS
-from dial.parser.check import Script
-from dial.parser.timeline import Layout, Placed, expand
+from dial.parser.script import Script
+from dial.parser.timeline import MAX_ITEMS, MAX_TICKS, Layout, Placed, PlacedWatch, Section, expand
 
 
 def _ranges(ticks: range) -> str:
@@ -16,8 +16,10 @@ def _ranges(ticks: range) -> str:
     return str(ticks.start) if len(ticks) == 1 else f"{ticks.start}-{ticks[-1]}"
 
 
-def _lane(placed: list[Placed], length: int) -> str:
+def _lane(placed: list[Placed], watched: list[PlacedWatch], length: int) -> str:
     cells = [" "] * length
+    for w in watched:
+        cells[w.start - 1 : w.end] = "~" * (w.end - w.start + 1)
     for p in placed:
         cells[p.start - 1] = "#"
         for t in range(p.start + 1, p.exec_end + 1):
@@ -35,26 +37,48 @@ def _ruler(length: int) -> str:
     return "".join(cells).rstrip()
 
 
+def _where(s: Section) -> str:
+    """A section's ticks; an ending takes none and happens after tick ``last``."""
+    return f"{s.first}-{s.last}" if s.first <= s.last else f"after {s.last}"
+
+
+def _compact_note(layout: Layout) -> str:
+    """What a compact layout leaves out."""
+    note = (
+        f"(shown compactly: expanded, the timeline exceeds {MAX_TICKS} ticks or "
+        f"{MAX_ITEMS} runs and sections, so each counted @repeat is drawn once and the ticks "
+        "below are not absolute"
+    )
+    if layout.cut:
+        note += f"; the chart stops after tick {layout.length}"
+    return note + ")"
+
+
 def render(script: Script, layout: Layout | None = None) -> str:
     """The chart (one lane per event), the sections, and every run with its ticks."""
     layout = layout or expand(script)
-    names: list[str] = []
-    for p in layout.runs:
-        if p.run.event not in names:
-            names.append(p.run.event)
+    names = list(layout.lanes)
     width = max([len(n) for n in names] + [len("tick")]) + 2
     tick = f"tick {script.tick:g} s" if script.tick is not None else "default tick"
     own = script.program.scene.text if script.program.scene else None
     scene = script.scene_override or own or "none"
-    out = [f"{script.path}: scene {scene}, {tick}, {layout.length} ticks", ""]
-    out.append("tick".ljust(width) + _ruler(layout.length))
+    out = [f"{script.path}: scene {scene}, {tick}, {layout.expanded or layout.length} ticks"]
+    if layout.compact:
+        out.append(_compact_note(layout))
+    out += ["", "tick".ljust(width) + _ruler(layout.length)]
+    runs: dict[str, list[Placed]] = {name: [] for name in names}
+    watched: dict[str, list[PlacedWatch]] = {name: [] for name in names}
+    for p in layout.runs:
+        runs[p.run.event].append(p)
+    for w in layout.watches:
+        watched[w.watch.event].append(w)
     for name in names:
-        lane = _lane([p for p in layout.runs if p.run.event == name], layout.length)
-        out.append(name.ljust(width) + lane)
-    out += ["", "sections:"]
-    span_w = max([len(f"{s.first}-{s.last}") for s in layout.sections] + [5])
+        out.append(name.ljust(width) + _lane(runs[name], watched[name], layout.length))
+    out += ["", "sections (#N: the block's number for --save-at block:N; #?: up to the run):"]
+    span_w = max([len(_where(s)) for s in layout.sections] + [5])
     for s in layout.sections:
-        out.append(f"  {f'{s.first}-{s.last}':<{span_w}}  {s.label}  ({s.path}:{s.line})")
+        number = "" if s.first > s.last else f"#{s.block}" if s.block is not None else "#?"
+        out.append(f"  {_where(s):<{span_w}}  {number:>5}  {s.label}  ({s.path}:{s.line})")
     out += ["", "runs:"]
     ev_w = max([len(n) for n in names] + [5])
     for p in layout.runs:
@@ -65,4 +89,10 @@ def render(script: Script, layout: Layout | None = None) -> str:
             f"  {p.run.event:<{ev_w}}  {_ranges(range(p.start, p.hold_end + 1)):>7}"
             f"  exec {_ranges(ex):<7}  held {_ranges(held):<7}  {effectors}"
         )
+    if layout.watches:
+        out += ["", "watched (sensed every control period):"]
+        for w in layout.watches:
+            where = f"{w.path}:{w.watch.line}"
+            ticks = _ranges(range(w.start, w.end + 1))
+            out.append(f"  {w.watch.event:<{ev_w}}  {ticks:>7}  ({where})")
     return "\n".join(out) + "\n"

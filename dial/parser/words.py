@@ -14,6 +14,8 @@ from dial.parser.ast import Param, Word
 
 _KEY = re.compile(r"[A-Za-z_][A-Za-z0-9_]*$")
 _WORD = re.compile(r"[^\s]+")
+_SPACE = re.compile(r"\s*")
+_HEAD = re.compile(r'[^\s="]*')  # up to a space, '=' or '"
 
 
 class WordError(Exception):
@@ -33,32 +35,39 @@ def _split_words(line: int, text: str, offset: int) -> tuple[Word, ...]:
     )
 
 
+def bare_words(line: int, code: str, start: int) -> list[Word] | None:
+    """The words of ``code[start:]`` if it has no quote and no ``=``, else None."""
+    if '"' in code or "=" in code:
+        return None
+    return [
+        Word(m.group(), Span(line, m.start() + 1, m.end() + 1)) for m in _WORD.finditer(code, start)
+    ]
+
+
 def tokenize(line: int, code: str, start: int) -> list[Param]:
     """Split ``code[start:]`` (comments already blanked) into parameters.
 
     Raises :class:`WordError` at the first malformed parameter.
     """
+    bare = bare_words(line, code, start)
+    if bare is not None:
+        return [Param(None, (w,), False, w.span) for w in bare]
     params: list[Param] = []
-    i = start
     n = len(code)
+    i = _SPACE.match(code, start).end()  # type: ignore[union-attr]  # matches empty too
     while i < n:
-        if code[i].isspace():
-            i += 1
-            continue
         begin = i
         key: str | None = None
         # A key=value pair: the key runs up to the first '=' of the token.
-        j = i
-        while j < n and not code[j].isspace() and code[j] not in '="':
-            j += 1
-        if j < n and code[j] == "=":
-            key = code[i:j]
+        head = _HEAD.match(code, i).end()  # type: ignore[union-attr]
+        if head < n and code[head] == "=":
+            key = code[i:head]
             if not _KEY.match(key):
                 raise WordError(
-                    Span(line, i + 1, j + 2),
-                    f"expected key=value with a name before '=', got '{code[i : j + 1]}'",
+                    Span(line, i + 1, head + 2),
+                    f"expected key=value with a name before '=', got '{code[i : head + 1]}'",
                 )
-            i = j + 1
+            i = head + 1
             if i >= n or code[i].isspace():
                 raise WordError(Span(line, begin + 1, i + 1), f"missing value after '{key}='")
         if code[i] == '"':
@@ -73,17 +82,15 @@ def tokenize(line: int, code: str, start: int) -> list[Param]:
                     f"expected a space after the closing quote, got '{code[end]}'",
                 )
             params.append(Param(key, words, True, Span(line, begin + 1, end + 1)))
-            i = end
-            continue
-        end = i
-        while end < n and not code[end].isspace():
-            if code[end] == '"':
+        else:
+            end = _WORD.match(code, i).end()  # type: ignore[union-attr]  # code[i] is no space
+            quote = code.find('"', i, end)
+            if quote >= 0:
                 raise WordError(
-                    Span(line, end + 1, end + 2),
+                    Span(line, quote + 1, quote + 2),
                     "unexpected '\"' inside a word: quote the whole parameter",
                 )
-            end += 1
-        word = Word(code[i:end], Span(line, i + 1, end + 1))
-        params.append(Param(key, (word,), False, Span(line, begin + 1, end + 1)))
-        i = end
+            word = Word(code[i:end], Span(line, i + 1, end + 1))
+            params.append(Param(key, (word,), False, Span(line, begin + 1, end + 1)))
+        i = _SPACE.match(code, end).end()  # type: ignore[union-attr]
     return params

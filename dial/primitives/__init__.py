@@ -1,37 +1,62 @@
-"""The instructions of DESIGN 3 on the MuJoCo robot: one primitive class per instruction."""
+"""The instructions of DESIGN 3 on the MuJoCo robot: one primitive class per instruction.
+
+Each catalogue entry names its class (``Instruction.primitive``); a test checks that every
+name resolves here. Zero-length instructions are sensors (``sense``); a contact
+instruction tested as a condition is sensed too.
+"""
 
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Any
 
+from dial.backend.snapshot import Snapshot
 from dial.primitives.arm import ArmMove, PumaCommand
 from dial.primitives.context import Context
 from dial.primitives.guarded import GuardedMove
 from dial.primitives.hand import FingerMove, GraspForce, HandPose, Limp
-from dial.primitives.sensing import make_sensing
-from dial.scheduler.types import Primitive, PrimitiveFactory, RunInfo
+from dial.primitives.sensing import ContactWait, Fit, Get, RecordContact
+from dial.scheduler.types import Ended, Primitive, PrimitiveFactory, RunInfo, Sensor
 
-_MAKERS: dict[str, Callable[[Context, RunInfo], Any]] = {
-    "hand_pose": HandPose,
-    "grasp_force": GraspForce,
-    "limp": Limp,
-    "finger_move": FingerMove,
-    "puma_command": PumaCommand,
-    "arm_move": ArmMove,
-    "guarded_move": GuardedMove,
+Made = Primitive[Snapshot] | Sensor[Snapshot]
+
+CLASSES: dict[str, Callable[[Context, RunInfo], Made]] = {
+    cls.__name__: cls
+    for cls in (
+        ArmMove,
+        ContactWait,
+        Fit,
+        FingerMove,
+        Get,
+        GraspForce,
+        GuardedMove,
+        HandPose,
+        Limp,
+        PumaCommand,
+        RecordContact,
+    )
 }
 
 
-def make_factory(ctx: Context) -> PrimitiveFactory:
-    """The scheduler's factory: a fresh primitive per run."""
+def make_factory(ctx: Context) -> PrimitiveFactory[Snapshot]:
+    """The runner's factory: a fresh primitive (or sensor) per run."""
 
-    def factory(info: RunInfo) -> Primitive:
-        maker = _MAKERS.get(info.event.instruction.name, make_sensing)
-        primitive: Primitive = maker(ctx, info)
-        return primitive
+    def factory(info: RunInfo) -> Made:
+        made = CLASSES[info.event.instruction.primitive](ctx, info)
+        if info.instant and isinstance(made, ContactWait):
+            return _Test(made)  # a contact wait tested as a condition: is it there now?
+        return made
 
     return factory
 
 
-__all__ = ["Context", "make_factory"]
+class _Test:
+    """A contact instruction as a condition-only event: a sensor, not a run."""
+
+    def __init__(self, wait: ContactWait) -> None:
+        self.wait = wait
+
+    def sense(self, snapshot: Snapshot) -> Ended:
+        return self.wait.sense(snapshot)
+
+
+__all__ = ["CLASSES", "Context", "make_factory"]

@@ -11,15 +11,16 @@ otherwise solve one waypoint per control period).
 from __future__ import annotations
 
 import math
+from abc import abstractmethod
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 
 from dial.backend.snapshot import FloatArray, Snapshot
-from dial.primitives.context import Context, RobotPrimitive, rpy_matrix
+from dial.geometry import rpy_matrix, slerp, smooth
+from dial.primitives.context import Context, RobotPrimitive
 from dial.scene.valii import Appro, Depart, Drive, Move, Statement
-from dial.scheduler.types import Ended, Now, RunInfo
+from dial.scheduler.types import DONE, Ended, Now, Outcome, RunInfo
 
 JOINT_SPEED = 1.0  # rad/s: nominal, only to share a run's time among its segments
 LINEAR_SPEED = 0.25  # m/s
@@ -29,29 +30,6 @@ TURN_SPEED = 1.0  # rad/s
 # the IK tolerance (0.5 mm).
 LINE_STEP = 0.004  # m
 LINE_TURN_STEP = np.radians(2.0)  # rad
-
-
-def smooth(u: float) -> float:
-    """Minimum-jerk time scaling of a segment: zero velocity and acceleration at both ends."""
-    u = min(1.0, max(0.0, u))
-    return u * u * u * (10.0 - 15.0 * u + 6.0 * u * u)
-
-
-def slerp(r0: FloatArray, r1: FloatArray, u: float) -> FloatArray:
-    """Rotation between ``r0`` and ``r1`` (u in [0, 1]) about their relative axis."""
-    rel = r0.T @ r1
-    angle = float(np.arccos(np.clip((np.trace(rel) - 1.0) / 2.0, -1.0, 1.0)))
-    if angle < 1e-9:
-        return r0.copy()
-    axis = np.array([rel[2, 1] - rel[1, 2], rel[0, 2] - rel[2, 0], rel[1, 0] - rel[0, 1]])
-    norm = np.linalg.norm(axis)
-    # A half turn has no antisymmetric part: its axis is the top eigenvector of rel + rel^T.
-    axis = np.linalg.eigh(rel + rel.T)[1][:, -1] if norm < 1e-9 else axis / norm
-    k = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
-    a = angle * u
-    step = np.eye(3) + np.sin(a) * k + (1.0 - np.cos(a)) * (k @ k)
-    out: FloatArray = r0 @ step
-    return out
 
 
 @dataclass(frozen=True)
@@ -89,6 +67,7 @@ class Planner:
     def __init__(self, ctx: Context, q: FloatArray) -> None:
         self.ctx, self.q = ctx, np.array(q, dtype=np.float64)
         self.segments: list[Segment] = []
+        self.warnings: list[str] = []
 
     def joint_to(self, q1: FloatArray) -> None:
         cost = float(np.abs(q1 - self.q).max()) / JOINT_SPEED
@@ -127,9 +106,23 @@ class Planner:
             p0, r0 = ik.fk(self.q)
             self.line_to(p0 - st.distance * r0[:, 2], r0, f"DEPART ({where})")
         else:
-            q1 = self.q.copy()
-            q1[st.joint - 1] += st.angle
-            self.joint_to(q1)
+            self.joint_to(self.drive(st, where))
+
+    def drive(self, st: Drive, where: str) -> FloatArray:
+        """DRIVE: one joint by an angle, stopped at the joint's limit with a warning."""
+        q1 = self.q.copy()
+        j = st.joint - 1
+        lo, hi = self.ctx.robot.arm_range[j]
+        goal = q1[j] + st.angle
+        q1[j] = min(hi, max(lo, goal))
+        if q1[j] != goal:
+            side, limit = ("upper", hi) if goal > hi else ("lower", lo)
+            self.warnings.append(
+                f"DRIVE {st.joint} {np.degrees(st.angle):g} ({where}): the target "
+                f"{np.degrees(goal):.1f} deg is {np.degrees(abs(goal - limit)):.1f} deg beyond "
+                f"joint {st.joint}'s {side} limit ({np.degrees(limit):.1f} deg); it stops there"
+            )
+        return q1
 
 
 class ArmMotion(RobotPrimitive):
@@ -139,15 +132,17 @@ class ArmMotion(RobotPrimitive):
         super().__init__(ctx, info)
         self.segments: list[Segment] = []
         self.bounds: list[float] = []
+        self.warnings: tuple[str, ...] = ()
 
+    @abstractmethod
     def plan(self, planner: Planner) -> None:
-        raise NotImplementedError
+        """Add this run's segments to ``planner``."""
 
-    def start(self, snapshot: Any) -> None:
-        assert isinstance(snapshot, Snapshot)
+    def start(self, snapshot: Snapshot) -> None:
         planner = Planner(self.ctx, snapshot.arm_target)
         self.plan(planner)
         self.segments = planner.segments
+        self.warnings = tuple(planner.warnings)
         total = sum(s.cost for s in self.segments)
         acc, self.bounds = 0.0, []
         for s in self.segments:
@@ -155,7 +150,7 @@ class ArmMotion(RobotPrimitive):
             self.bounds.append(acc)
         self.q = snapshot.arm_target.copy()
 
-    def step(self, snapshot: Any, now: Now) -> Ended | None:
+    def step(self, snapshot: Snapshot, now: Now) -> Ended | None:
         if not self.segments:
             return None
         start = 0.0
@@ -167,6 +162,9 @@ class ArmMotion(RobotPrimitive):
         self.slots.arm(self.q)
         return None
 
+    def finish(self, snapshot: Snapshot) -> Ended:
+        return Ended(Outcome.DONE, warnings=self.warnings) if self.warnings else DONE
+
 
 class PumaCommand(ArmMotion):
     """``puma_command "ex PROG" | "move LOC" | ...``: the VAL-II subset."""
@@ -174,21 +172,21 @@ class PumaCommand(ArmMotion):
     def plan(self, planner: Planner) -> None:
         verb = self.arg("verb")
         if verb == "ex":
-            name = self.arg("program")
+            name = str(self.arg("program"))
             for stored in self.ctx.world.programs[name].statements:
                 planner.statement(stored, f"program {name}, line {stored.line}")
             return
         line = 1
         st: Statement
         if verb in ("move", "moves"):
-            st = Move(line, self.arg("location"), verb == "moves")
+            st = Move(line, str(self.arg("location")), verb == "moves")
         elif verb == "appro":
-            st = Appro(line, self.arg("location"), self.arg("distance"))
+            st = Appro(line, str(self.arg("location")), self.num("distance"))
         elif verb == "depart":
-            st = Depart(line, self.arg("distance"))
+            st = Depart(line, self.num("distance"))
         else:
-            st = Drive(line, self.arg("joint"), self.arg("angle"))
-        planner.statement(st, verb)
+            st = Drive(line, int(self.num("joint")), self.num("angle"))
+        planner.statement(st, str(verb))
 
 
 class ArmMove(ArmMotion):
@@ -196,8 +194,8 @@ class ArmMove(ArmMotion):
 
     def plan(self, planner: Planner) -> None:
         p0, r0 = self.ctx.arm_ik.fk(planner.q)
-        d = np.array([self.arg("dx"), self.arg("dy"), self.arg("dz")], dtype=np.float64)
-        turn = rpy_matrix((self.arg("rx"), self.arg("ry"), self.arg("rz")))
+        d = np.array([self.num("dx"), self.num("dy"), self.num("dz")], dtype=np.float64)
+        turn = rpy_matrix((self.num("rx"), self.num("ry"), self.num("rz")))
         if self.arg("frame") == "tool":
             p1, r1 = p0 + r0 @ d, r0 @ turn
         else:

@@ -13,8 +13,6 @@ for ``record_contact at=stop``: a light contact may fade within tens of ms.
 
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
 
 from dial.backend.snapshot import FloatArray, Snapshot
@@ -27,21 +25,24 @@ class GuardedMove(RobotPrimitive):
     def __init__(self, ctx: Context, info: RunInfo) -> None:
         super().__init__(ctx, info)
         finger = self.arg("finger")
-        self.finger: int | None = None if finger is None else int(finger)
-        d = np.array([self.arg("dx"), self.arg("dy"), self.arg("dz")], dtype=np.float64)
-        self.length = float(self.arg("max") or np.linalg.norm(d))
+        self.finger: int | None = finger if isinstance(finger, int) else None
+        d = np.array([self.num("dx"), self.num("dy"), self.num("dz")], dtype=np.float64)
+        travel = self.arg("max")
+        self.length = float(travel) if isinstance(travel, float) else float(np.linalg.norm(d))
         self.direction = d / np.linalg.norm(d)
-        self.speed = float(self.arg("speed"))
-        self.press = float(self.arg("press"))
+        self.speed = self.num("speed")
+        self.press = self.num("press")
         sense = self.arg("sense")
-        if sense is not None:
-            self.sense: tuple[int, ...] = (int(sense),)
+        if isinstance(sense, int):
+            self.sense: tuple[int, ...] = (sense,)
         else:
             self.sense = (self.finger,) if self.finger is not None else tuple(range(4))
+        until = self.arg("until")
+        assert isinstance(until, tuple)
+        self.until: tuple[tuple[str, float], ...] = until
         self.guard = 0
 
-    def start(self, snapshot: Any) -> None:
-        assert isinstance(snapshot, Snapshot)
+    def start(self, snapshot: Snapshot) -> None:
         frame = self.arg("frame") or ("tool" if self.finger is None else "palm")
         world = frame == "world"
         self.delta = self.direction if world else snapshot.tool_rot @ self.direction
@@ -53,12 +54,11 @@ class GuardedMove(RobotPrimitive):
         else:
             self.p0 = self.ctx.finger_ik.tip(self.arm_q, self.hand, self.finger)
         effector = "arm" if self.finger is None else FINGERS[self.finger]
-        self.guard = self.ctx.robot.arm_guard(effector, self.arg("until"), self.sense)
+        self.guard = self.slots.guard(effector, self.until, self.sense)
         for f in self.sense:  # a stop recorded before this move is not this move's contact
             self.ctx.stops.pop(f, None)
 
-    def step(self, snapshot: Any, now: Now) -> Ended | None:
-        assert isinstance(snapshot, Snapshot)
+    def step(self, snapshot: Snapshot, now: Now) -> Ended | None:
         trip = snapshot.trips.get(self.guard)
         travel = min(self.speed * (now.elapsed - self.info.period), self.length)
         if trip is not None:
@@ -96,4 +96,4 @@ class GuardedMove(RobotPrimitive):
             self.slots.joints(0xF << (4 * self.finger), self.hand)
 
     def stop(self) -> None:
-        self.ctx.robot.disarm(self.guard)
+        self.slots.unguard(self.guard)

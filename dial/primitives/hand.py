@@ -2,12 +2,10 @@
 
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
 
 from dial.backend.snapshot import FloatArray, Snapshot
-from dial.primitives.arm import smooth
+from dial.geometry import smooth
 from dial.primitives.context import Context, RobotPrimitive, done, missed
 from dial.scheduler.types import Ended, Now, RunInfo
 
@@ -19,17 +17,16 @@ def _bits(mask: int) -> list[int]:
 class HandPose(RobotPrimitive):
     """``hand_pose "NAME" [fingers=MASK]``: GOTO for ``#``, interpolated for ``#===``."""
 
-    def start(self, snapshot: Any) -> None:
-        assert isinstance(snapshot, Snapshot)
-        pose = self.ctx.world.poses[self.arg("pose")]
+    def start(self, snapshot: Snapshot) -> None:
+        pose = self.ctx.world.poses[str(self.arg("pose"))]
         fingers = self.arg("fingers")
-        self.mask = pose.mask & (fingers if fingers is not None else 0xFFFF)
+        self.mask = pose.mask & (fingers if isinstance(fingers, int) else 0xFFFF)
         self.q0 = snapshot.hand_target.copy()
         self.q1 = self.q0.copy()
         for bit, angle in pose.angles.items():
             self.q1[bit] = angle
 
-    def step(self, snapshot: Any, now: Now) -> Ended | None:
+    def step(self, snapshot: Snapshot, now: Now) -> Ended | None:
         self.slots.joints(self.mask, self.q0 + (self.q1 - self.q0) * smooth(now.progress))
         return None
 
@@ -44,11 +41,12 @@ class GraspForce(RobotPrimitive):
     and missed if they all reach their joint limits first.
     """
 
-    def start(self, snapshot: Any) -> None:
-        assert isinstance(snapshot, Snapshot)
-        self.jmask, self.tmask = self.arg("masks")
-        self.force = float(self.arg("force"))
-        self.rate = float(self.arg("speed")) * self.info.period
+    def start(self, snapshot: Snapshot) -> None:
+        masks = self.arg("masks")
+        assert isinstance(masks, tuple)
+        self.jmask, self.tmask = masks
+        self.force = self.num("force")
+        self.rate = self.num("speed") * self.info.period
         self.target = snapshot.hand_target.copy()
         self.upper = self.ctx.robot.hand_range[:, 1]
         self.fingers = sorted({k // 4 for k in _bits(self.jmask)})
@@ -59,8 +57,7 @@ class GraspForce(RobotPrimitive):
         }
         self.stopped: dict[int, float] = {}
 
-    def step(self, snapshot: Any, now: Now) -> Ended | None:
-        assert isinstance(snapshot, Snapshot)
+    def step(self, snapshot: Snapshot, now: Now) -> Ended | None:
         diff = snapshot.differentials
         for f in self.fingers:
             if f not in self.stopped and max(diff[k] for k in self.watched[f]) >= self.force:
@@ -84,41 +81,42 @@ class Limp(RobotPrimitive):
 
     def __init__(self, ctx: Context, info: RunInfo) -> None:
         super().__init__(ctx, info)
-        self.mask = int(self.arg("fingers"))
+        self.mask = int(self.num("fingers"))
+        self.limp = False
 
-    def start(self, snapshot: Any) -> None:
+    def start(self, snapshot: Snapshot) -> None:
         self.slots.limp(self.mask, True)
+        self.limp = True
 
-    def step(self, snapshot: Any, now: Now) -> Ended | None:
+    def step(self, snapshot: Snapshot, now: Now) -> Ended | None:
         return None
 
-    def finish(self, snapshot: Any) -> Ended:
-        assert isinstance(snapshot, Snapshot)
+    def finish(self, snapshot: Snapshot) -> Ended:
         self.slots.limp(self.mask, False)
+        self.limp = False
         pose = {f"j{k}": float(np.degrees(snapshot.hand_q[k])) for k in _bits(self.mask)}
         save = self.arg("save")
         return done(pose_deg=pose, **({"saved_as": save} if save else {}))
 
-    def stop(self) -> None:  # cancelled mid-run: stiffen where the joints are
-        if self.ctx.robot.limp[_bits(self.mask)].any():
+    def stop(self) -> None:  # ended early (preempted, aborted): stiffen where the joints are
+        if self.limp:
             self.slots.limp(self.mask, False)
 
 
 class FingerMove(RobotPrimitive):
     """``finger_move finger=F DX DY DZ [frame=palm|world]``: a straight fingertip line by IK."""
 
-    def start(self, snapshot: Any) -> None:
-        assert isinstance(snapshot, Snapshot)
-        self.finger = int(self.arg("finger"))
+    def start(self, snapshot: Snapshot) -> None:
+        self.finger = int(self.num("finger"))
         self.arm_q = snapshot.arm_target.copy()
         self.hand = snapshot.hand_target.copy()
         ik = self.ctx.finger_ik
         self.tip0 = ik.tip(self.arm_q, self.hand, self.finger)
-        d = np.array([self.arg("dx"), self.arg("dy"), self.arg("dz")], dtype=np.float64)
+        d = np.array([self.num("dx"), self.num("dy"), self.num("dz")], dtype=np.float64)
         self.delta: FloatArray = snapshot.tool_rot @ d if self.arg("frame") == "palm" else d
         self.mask = 0xF << (4 * self.finger)
 
-    def step(self, snapshot: Any, now: Now) -> Ended | None:
+    def step(self, snapshot: Snapshot, now: Now) -> Ended | None:
         goal = self.tip0 + self.delta * smooth(now.progress)
         self.hand = self.ctx.finger_ik.track(self.finger, goal, self.arm_q, self.hand)
         self.slots.joints(self.mask, self.hand)

@@ -1,8 +1,6 @@
-"""Sensing: snapshots into the log, contact waits, contact points and fits."""
+"""Sensing: snapshots into the log, contact waits and tests, contact points and fits."""
 
 from __future__ import annotations
-
-from typing import Any
 
 import numpy as np
 
@@ -10,19 +8,19 @@ from dial.backend.contact import contact_reading
 from dial.backend.locate import finger_bodies, link_point, tactile_point
 from dial.backend.snapshot import FloatArray, Snapshot
 from dial.haptics import FitError, fit_plane, fit_superquadric
+from dial.instructions.catalogue import contact_condition
 from dial.instructions.types import FINGERS
 from dial.primitives.context import Context, RobotPrimitive, done, missed
-from dial.scheduler.types import Ended, InstantPrimitive, Now, Outcome, RunInfo
+from dial.scheduler.types import Ended, Now, Outcome, RunInfo
 
 
-class Get(InstantPrimitive):
+class Get:
     """``get_joints``, ``get_forces``, ``get_tactile``, ``get_wrist``: record a snapshot."""
 
     def __init__(self, ctx: Context, info: RunInfo) -> None:
         self.what = info.event.instruction.name
 
-    def sense(self, snapshot: Any) -> Ended:
-        assert isinstance(snapshot, Snapshot)
+    def sense(self, snapshot: Snapshot) -> Ended:
         if self.what == "get_joints":
             return done(hand_q=snapshot.hand_q, arm_q=snapshot.arm_q)
         if self.what == "get_forces":
@@ -33,7 +31,10 @@ class Get(InstantPrimitive):
 
 
 def contact_value(kind: str, snapshot: Snapshot, finger: int, baseline: FloatArray | None) -> float:
-    """The reading a contact condition compares with its threshold (m or N)."""
+    """The reading a contact condition compares with its threshold (m or N); a dropped-out
+    sensor reads 0, as the driver's guards read it."""
+    if (kind, finger) in snapshot.dropped:
+        return 0.0
     return contact_reading(
         kind,
         finger,
@@ -46,41 +47,33 @@ def contact_value(kind: str, snapshot: Snapshot, finger: int, baseline: FloatArr
 
 
 class ContactWait(RobotPrimitive):
-    """``position_contact``, ``force_contact``, ``tactile_contact``: wait for the signal."""
+    """``position_contact``, ``force_contact``, ``tactile_contact``.
+
+    In a diagram: wait until the contact is signalled (a force change counts from the
+    run's start). As a condition-only event: is the contact there now (:meth:`sense`)?
+    """
 
     def __init__(self, ctx: Context, info: RunInfo) -> None:
         super().__init__(ctx, info)
-        self.kind = info.event.instruction.name.removesuffix("_contact")
-        self.finger = int(self.arg("finger"))
-        self.threshold = float(self.arg("threshold"))
+        self.kind, self.finger, self.threshold = contact_condition(
+            info.event.instruction, info.event.args
+        )
 
-    def start(self, snapshot: Any) -> None:
-        assert isinstance(snapshot, Snapshot)
+    def start(self, snapshot: Snapshot) -> None:
         self.baseline = snapshot.differentials.copy()
 
-    def step(self, snapshot: Any, now: Now) -> Ended | None:
-        assert isinstance(snapshot, Snapshot)
+    def step(self, snapshot: Snapshot, now: Now) -> Ended | None:
         value = contact_value(self.kind, snapshot, self.finger, self.baseline)
         return done(value=value) if value >= self.threshold else None
 
-
-class ContactTest(InstantPrimitive):
-    """A contact wait used as a condition-only event: is there contact now?"""
-
-    def __init__(self, ctx: Context, info: RunInfo) -> None:
-        self.kind = info.event.instruction.name.removesuffix("_contact")
-        self.finger = int(info.event.args["finger"])
-        self.threshold = float(info.event.args["threshold"])
-
-    def sense(self, snapshot: Any) -> Ended:
-        assert isinstance(snapshot, Snapshot)
+    def sense(self, snapshot: Snapshot) -> Ended:
         value = contact_value(self.kind, snapshot, self.finger, None)
         if value >= self.threshold:
             return done(value=value)
         return missed(f"no {self.kind} contact on the {FINGERS[self.finger]}", value=value)
 
 
-class RecordContact(InstantPrimitive):
+class RecordContact:
     """``record_contact finger=F [into=SET] [at=now|stop] [source=tactile|links]``.
 
     Appends where the finger touches (world m) to a point set: the depth-weighted taxel
@@ -90,13 +83,14 @@ class RecordContact(InstantPrimitive):
 
     def __init__(self, ctx: Context, info: RunInfo) -> None:
         self.ctx = ctx
-        self.finger = int(info.event.args["finger"])
+        finger = info.event.args["finger"]
+        assert isinstance(finger, int)
+        self.finger = finger
         self.set = str(info.event.args["into"])
         self.at = str(info.event.args["at"])
         self.source = str(info.event.args["source"])
 
-    def sense(self, snapshot: Any) -> Ended:
-        assert isinstance(snapshot, Snapshot)
+    def sense(self, snapshot: Snapshot) -> Ended:
         name = FINGERS[self.finger]
         if self.at == "stop":
             stop = self.ctx.stops.get(self.finger)
@@ -114,13 +108,13 @@ class RecordContact(InstantPrimitive):
         return done(point=point, set=self.set, count=len(points))
 
     def _now(self, snapshot: Snapshot) -> FloatArray | None:
-        model, data = self.ctx.robot.model, self.ctx.robot.data
-        if self.source == "tactile":
-            return tactile_point(model, data, self.finger, snapshot.tactile[self.finger])
-        return link_point(model, data, finger_bodies(model, self.finger))
+        robot = self.ctx.robot
+        if self.source == "tactile":  # a dropped-out array reads 0 in the snapshot
+            return tactile_point(snapshot.tactile[self.finger], robot.taxel_points(self.finger))
+        return link_point(robot.model, robot.data, finger_bodies(robot.model, self.finger))
 
 
-class Fit(InstantPrimitive):
+class Fit:
     """``fit_plane SET`` and ``fit_superquadric SET``: least squares over a point set."""
 
     def __init__(self, ctx: Context, info: RunInfo) -> None:
@@ -128,7 +122,7 @@ class Fit(InstantPrimitive):
         self.set = str(info.event.args["set"])
         self.kind = info.event.instruction.name
 
-    def sense(self, snapshot: Any) -> Ended:
+    def sense(self, snapshot: Snapshot) -> Ended:
         points = np.array(self.ctx.point_sets.get(self.set, []), dtype=np.float64).reshape(-1, 3)
         try:
             fit = fit_plane(points) if self.kind == "fit_plane" else fit_superquadric(points)
@@ -137,14 +131,3 @@ class Fit(InstantPrimitive):
         result = fit.as_result()
         self.ctx.results[self.set] = result
         return done(set=self.set, points=len(points), **result)
-
-
-def make_sensing(ctx: Context, info: RunInfo) -> Any:
-    name = info.event.instruction.name
-    if name.startswith("get_"):
-        return Get(ctx, info)
-    if name == "record_contact":
-        return RecordContact(ctx, info)
-    if name.startswith("fit_"):
-        return Fit(ctx, info)
-    return ContactTest(ctx, info) if info.instant else ContactWait(ctx, info)

@@ -14,29 +14,28 @@ import numpy as np
 from dial.backend.model import RobotIndex
 from dial.backend.snapshot import FloatArray
 from dial.recording.geometry import moving_bodies
+from dial.recording.task import TaskProbe
 
 RECORD_HZ = 50.0  # frames per second of simulated time in a recording
-
-
-def every(rate_hz: float, period: float) -> int:
-    """Control periods between samples: a whole number, so the rate is steady in sim time."""
-    return max(1, round(1.0 / (rate_hz * period)))
 
 
 @dataclass(frozen=True)
 class Batch:
     """``n`` frames: ``time_ns`` (n,) simulated ns; ``tick`` (n,); body poses in the world,
     ``pos`` (n, B, 3) m and ``quat`` (n, B, 4) (x, y, z, w) for the bodies ``Frames.bodies``;
-    ``joints`` (n, 16) rad, mask order; ``tensions`` (n, 32) N, tendon order; ``tactile``
-    (n, 4, 16, 16) m, finger, row, column."""
+    ``joints`` (n, 16) rad, mask order; ``arm`` (n, 6) rad, PUMA joints 1-6; ``tensions``
+    (n, 32) N, tendon order; ``tactile`` (n, 4, 16, 16) m, finger, row, column; ``task``
+    (n, S) the task's measurements (:class:`~dial.recording.task.TaskProbe`)."""
 
     time_ns: np.ndarray
     tick: np.ndarray
     pos: FloatArray
     quat: FloatArray
     joints: FloatArray
+    arm: FloatArray
     tensions: FloatArray
     tactile: FloatArray
+    task: FloatArray
 
     def __len__(self) -> int:
         return len(self.time_ns)
@@ -45,8 +44,9 @@ class Batch:
 class Frames:
     """Collects frames from ``MjData`` until :meth:`take` hands them over."""
 
-    def __init__(self, model: mujoco.MjModel) -> None:
+    def __init__(self, model: mujoco.MjModel, probe: TaskProbe | None = None) -> None:
         self.index = RobotIndex.from_model(model)
+        self.probe = probe
         self.bodies = moving_bodies(model)
         self._tactile = [int(a) for a in self.index.tactile_sensors]
         self._rows: list[tuple[int, int, FloatArray, FloatArray, FloatArray]] = []
@@ -66,8 +66,10 @@ class Frames:
                 np.concatenate(
                     [
                         data.qpos[ix.hand_qpos],
+                        data.qpos[ix.arm_qpos],
                         sd[ix.tension_sensors] if tensions is None else tensions,
                         tactile,
+                        self.probe.sample(data) if self.probe is not None else (),
                     ]
                 ),
             )
@@ -86,8 +88,10 @@ class Frames:
             pos=np.stack([r[2] for r in rows]),
             quat=quat[..., [1, 2, 3, 0]],  # MuJoCo's (w, x, y, z) to rerun's (x, y, z, w)
             joints=flat[:, :16],
-            tensions=flat[:, 16:48],
-            tactile=flat[:, 48:].reshape(-1, 4, 16, 16),
+            arm=flat[:, 16:22],
+            tensions=flat[:, 22:54],
+            tactile=flat[:, 54:1078].reshape(-1, 4, 16, 16),
+            task=flat[:, 1078:],
         )
 
     def __len__(self) -> int:

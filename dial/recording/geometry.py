@@ -6,7 +6,8 @@ Pure MuJoCo and numpy; the rerun calls live in :mod:`dial.recording.rerun_sink`.
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
+from collections.abc import Mapping
+from dataclasses import dataclass, replace
 
 import mujoco
 import numpy as np
@@ -22,6 +23,12 @@ KINDS = {
     mujoco.mjtGeom.mjGEOM_BOX: "box",
     mujoco.mjtGeom.mjGEOM_MESH: "mesh",
 }  # planes (the floor) are left to the viewer's ground grid
+
+
+TASK_AZIMUTH, TASK_ELEVATION = 165.0, -18.0  # deg: from the front, a little from the side
+WORKSPACE_ABOVE = 0.3  # m above the objects that the hand works in
+EYE_AZIMUTH, EYE_ELEVATION = 135.0, -25.0  # deg: more from the side and from above, so
+# that the hand shows beside the objects it works on, and into cups
 
 
 @dataclass(frozen=True)
@@ -51,7 +58,28 @@ def task_camera(data: mujoco.MjData, objects: list[int]) -> Camera:
     """
     centre = data.xpos[objects].mean(axis=0) if objects else np.array([0.5, 0.0, 0.35])
     lookat = (0.9 * float(centre[0]), float(centre[1]), float(centre[2]) + 0.2)
-    return Camera(lookat, distance=1.1, azimuth=165.0, elevation=-18.0)
+    return Camera(lookat, distance=1.1, azimuth=TASK_AZIMUTH, elevation=TASK_ELEVATION)
+
+
+def workspace_eye(
+    data: mujoco.MjData, objects: list[int], fov_deg: float = 75.0
+) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
+    """A viewer's eye on the task's workspace: the objects, and the hand as it works on
+    them. ``(position, look_target)`` in m: from the task camera's direction, looking at a
+    point above the objects, near enough that the workspace fills the vertical field of view
+    ``fov_deg``."""
+    points = data.xpos[objects] if objects else np.array([[0.5, 0.0, 0.35]])
+    low, high = points.min(axis=0), points.max(axis=0)
+    target = (low + high) / 2.0 + np.array([0.0, 0.0, WORKSPACE_ABOVE / 2.0])
+    radius = float(np.linalg.norm(high - low)) / 2.0 + WORKSPACE_ABOVE
+    distance = radius / np.tan(np.radians(fov_deg) / 2.0)
+    az, el = np.radians(EYE_AZIMUTH), np.radians(EYE_ELEVATION)
+    forward = np.array([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)])
+    eye = target - distance * forward
+    return (
+        (float(eye[0]), float(eye[1]), float(eye[2])),
+        (float(target[0]), float(target[1]), float(target[2])),
+    )
 
 
 @dataclass(frozen=True, eq=False)
@@ -87,6 +115,46 @@ def body_names(model: mujoco.MjModel) -> list[str]:
     return entity_names(model, mujoco.mjtObj.mjOBJ_BODY, model.nbody, "body")
 
 
+GROUPS = (("puma_", "arm/"), ("hand_", "hand/"))  # body-name prefix -> entity group
+
+
+def body_paths(model: mujoco.MjModel, objects: Mapping[str, str]) -> list[str]:
+    """Each body's entity path under ``world``, readable on hover: ``arm/link2``,
+    ``hand/index_distal``, a scene object by its alias (``bulb``; ``objects`` maps aliases to
+    body names), ``scene/<body>`` for the rest, and ``scene/static`` for the world body."""
+    alias = {body: name for name, body in objects.items()}
+    paths = []
+    for i, name in enumerate(body_names(model)):
+        group = next((g + name[len(p) :] for p, g in GROUPS if name.startswith(p)), None)
+        paths.append("scene/static" if i == 0 else alias.get(name) or group or f"scene/{name}")
+    return paths
+
+
+def geom_labels(model: mujoco.MjModel, geoms: list[int], kinds: list[str]) -> list[str]:
+    """Entity path parts for ``geoms`` (of ``kinds``): a geom's own name less the words it
+    shares with its body's (``hand_index_pad`` on ``hand_index_distal``: ``pad``), else its
+    kind; numbered when a body has several (``capsule``, ``box_2``)."""
+    names = entity_names(model, mujoco.mjtObj.mjOBJ_GEOM, model.ngeom, "")
+    bodies = body_names(model)
+    labels: list[str] = []
+    seen: set[tuple[str, str]] = set()
+    for g, kind in zip(geoms, kinds, strict=True):
+        body = bodies[int(model.geom_bodyid[g])]
+        words, shared = names[g].split("_"), body.split("_")
+        n = 0
+        while n < min(len(words) - 1, len(shared)) and words[n] == shared[n]:
+            n += 1
+        named = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_GEOM, g)
+        name = "_".join(words[n:]) if named else kind
+        label, count = name, 1
+        while (body, label) in seen:
+            count += 1
+            label = f"{name}_{count}"
+        seen.add((body, label))
+        labels.append(label)
+    return labels
+
+
 def moving_bodies(model: mujoco.MjModel) -> np.ndarray:
     """Ids of the bodies that can move: those not welded to the world (the arm, hand, objects)."""
     return np.flatnonzero(model.body_weldid != 0)
@@ -94,8 +162,8 @@ def moving_bodies(model: mujoco.MjModel) -> np.ndarray:
 
 def shapes(model: mujoco.MjModel) -> list[Shape]:
     """Every geom in groups 0-3 with a drawable type and a visible colour, in geom order."""
-    names = entity_names(model, mujoco.mjtObj.mjOBJ_GEOM, model.ngeom, "geom")
     out = []
+    drawn = []
     for g in range(model.ngeom):
         kind = KINDS.get(mujoco.mjtGeom(int(model.geom_type[g])))
         mat = int(model.geom_matid[g])
@@ -109,10 +177,11 @@ def shapes(model: mujoco.MjModel) -> list[Shape]:
             f0, nf = int(model.mesh_faceadr[mesh]), int(model.mesh_facenum[mesh])
             vertices = model.mesh_vert[v0 : v0 + nv].astype(np.float64)
             faces = model.mesh_face[f0 : f0 + nf].copy()
+        drawn.append(g)
         out.append(
             Shape(
                 body=int(model.geom_bodyid[g]),
-                name=names[g],
+                name="",
                 kind=kind,
                 size=model.geom_size[g].copy(),
                 pos=model.geom_pos[g].copy(),
@@ -122,7 +191,8 @@ def shapes(model: mujoco.MjModel) -> list[Shape]:
                 faces=faces,
             )
         )
-    return out
+    labels = geom_labels(model, drawn, [s.kind for s in out])
+    return [replace(s, name=label) for s, label in zip(out, labels, strict=True)]
 
 
 def superquadric_mesh(

@@ -1,4 +1,4 @@
-"""Observers of a run (see :class:`dial.engine.Observer`): the rerun recorder and the state log.
+"""The rerun recorder, an observer of a run (see :class:`dial.engine.Observer`).
 
 They sample on whole numbers of control periods, so a frame's time is exact simulated time
 and the same run gives the same frames.
@@ -7,44 +7,76 @@ and the same run gives the same frames.
 from __future__ import annotations
 
 import mujoco
-import numpy as np
 
-from dial.backend.driver import MujocoRobot
 from dial.engine import RunResult, Watched
-from dial.recording.frames import RECORD_HZ, Frames, every
-from dial.recording.geometry import task_camera
+from dial.engine.observe import every
+from dial.parser.lanes import LanePlan
+from dial.recording.frames import RECORD_HZ, Frames
+from dial.recording.geometry import workspace_eye
 from dial.recording.rerun_sink import RerunSink
-from dial.scheduler.log import EventLog
-
-STATE_HZ = 25.0  # state records per second of simulated time (--log-states)
-STATE_DIGITS = 4  # 0.1 mm and 0.1 mrad: plenty to draw, and a third shorter than the default
-TENSION_DIGITS = 2  # 0.01 N
+from dial.recording.task import TaskProbe
+from dial.scene.world import World
 
 
 def object_bodies(model: mujoco.MjModel, bodies: list[str]) -> list[int]:
     return [int(mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, b)) for b in bodies]
 
 
-class Recorder:
-    """Records a run into a :class:`RerunSink`: frames at ``rate_hz``, every log record."""
+def open_scene(
+    sink: RerunSink,
+    model: mujoco.MjModel,
+    data: mujoco.MjData,
+    world: World,
+    title: str,
+    plan: LanePlan | None,
+) -> Frames:
+    """Send the scene and the layout to ``sink``; the frames to fill, with the task's probe."""
+    probe = TaskProbe(model, world.criteria, world.objects)
+    eye = workspace_eye(data, object_bodies(model, list(world.objects.values())))
+    sink.scene(model, data, title, eye, world.objects, probe.series, plan)
+    return Frames(model, probe)
 
-    def __init__(self, sink: RerunSink, title: str, rate_hz: float = RECORD_HZ) -> None:
-        self.sink, self.title, self.rate_hz = sink, title, rate_hz
+
+class Recorder:
+    """Records a run into a :class:`RerunSink`: frames at ``rate_hz``, every log record.
+
+    ``plan`` (the script's lanes, :meth:`LanePlan.from_script`) orders the event lanes as in
+    the script and draws holds; without it lanes come in the order events first run.
+    """
+
+    what = "the rerun recording"  # how messages name it
+
+    def __init__(
+        self,
+        sink: RerunSink,
+        title: str,
+        rate_hz: float = RECORD_HZ,
+        plan: LanePlan | None = None,
+    ) -> None:
+        self.sink, self.title, self.rate_hz, self.plan = sink, title, rate_hz, plan
         self._seen = 0  # log records already sent
         self._tick = 0
+        self._now = (0, 0)  # (periods, tick) of the last period
 
     def begin(self, run: Watched) -> None:
         self.robot, self.log = run.robot, run.log
         model, data = run.robot.model, run.robot.data
-        self.frames = Frames(model)
+        self.frames = open_scene(self.sink, model, data, run.world, self.title, self.plan)
         self.every = every(self.rate_hz, run.robot.period)
-        camera = task_camera(data, object_bodies(model, list(run.world.objects.values())))
-        self.sink.scene(model, data, self.title, camera)
         self._capture(0, 0)
 
     def period(self, periods: int, tick: int) -> None:
+        self._now = (periods, tick)
         if periods % self.every == 0:
             self._capture(periods, tick)
+
+    def show_now(self) -> None:
+        """A paused run: record this moment (unless it was just recorded) and send it."""
+        periods, tick = self._now
+        if periods % self.every:
+            self._capture(periods, tick)
+        self._drain()
+        self._send()
 
     def _capture(self, periods: int, tick: int) -> None:
         self._tick = tick
@@ -68,50 +100,6 @@ class Recorder:
             self.sink.frames(batch)
 
     def end(self, result: RunResult | None) -> None:
-        self._drain()
+        self._drain()  # the log's last record is the engine's summary
         self._send()
-        if result is not None:
-            summary = {
-                "kind": "summary",
-                "ok": result.ok,
-                "success": result.success,
-                "criteria": result.details,
-                "sim_time": result.summary.sim_time,
-            }
-            self.sink.record(summary, self._tick, None)
         self.sink.close()
-
-
-class StateLog:
-    """Writes ``state`` records into the log at ``rate_hz`` (``--log-states``), for replay.
-
-    The one observer that writes: it adds records to the log, and only when asked.
-    A record holds ``t``, ``tick``, the whole ``qpos`` (the arm, the hand, and every free
-    object) and the 32 tendon ``tension``s, which cannot be recomputed from positions.
-    """
-
-    def __init__(self, rate_hz: float = STATE_HZ) -> None:
-        self.rate_hz = rate_hz
-
-    def begin(self, run: Watched) -> None:
-        self.robot: MujocoRobot = run.robot
-        self.log: EventLog = run.log
-        self.every = every(self.rate_hz, run.robot.period)
-        self._write(0, 0)
-
-    def period(self, periods: int, tick: int) -> None:
-        if periods % self.every == 0:
-            self._write(periods, tick)
-
-    def _write(self, periods: int, tick: int) -> None:
-        d, ix = self.robot.data, self.robot.index
-        self.log.write(
-            "state",
-            tick=tick,
-            t=periods * self.robot.period,
-            qpos=np.round(d.qpos, STATE_DIGITS),
-            tension=np.round(d.sensordata[ix.tension_sensors], TENSION_DIGITS),
-        )
-
-    def end(self, result: RunResult | None) -> None:
-        """Nothing to close: the log belongs to the run."""

@@ -18,9 +18,9 @@ import numpy as np
 
 from dial.backend.model import load_model
 from dial.errors import DialError
-from dial.recording.frames import Frames
 from dial.recording.geometry import task_camera
-from dial.recording.observers import object_bodies
+from dial.recording.lanes import LanePlan
+from dial.recording.observers import object_bodies, open_scene
 from dial.recording.rerun_sink import RerunSink
 from dial.recording.video import VIDEO_FPS, Renderer, VideoFile
 from dial.scene.resolve import resolve_scene
@@ -67,7 +67,7 @@ def rebuild(records: Sequence[dict[str, Any]], out: Path, title: str, base: Path
     world, model, data, states = _replayed(records, base, "a recording")
     sink = RerunSink(out)
     try:
-        _send(records, model, data, sink, title, list(world.objects.values()))
+        _send(records, model, data, sink, title, world)
     finally:
         sink.close()
     return len(states)
@@ -101,10 +101,10 @@ def _send(
     data: mujoco.MjData,
     sink: RerunSink,
     title: str,
-    objects: list[str],
+    world: World,
 ) -> None:
-    sink.scene(model, data, title, task_camera(data, object_bodies(model, objects)))
-    frames = Frames(model)
+    plan = next((LanePlan.from_record(r) for r in records if r["kind"] == "lanes"), None)
+    frames = open_scene(sink, model, data, world, title, plan)
     tips = frames.index.fingertip_sites
     tick = 0
     for record in records:

@@ -1,93 +1,64 @@
-"""Every rerun call in dial: a run as a ``.rrd`` recording or a live stream to a viewer.
+"""Every rerun call in dial but the layout's (:mod:`dial.recording.layout`): a run as a ``.rrd``
+recording or a live stream to a viewer.
 
-Layout (entity paths):
+Entity paths:
 
-- ``world``: the scene, z up. ``world/<body>`` holds a body's pose in the world frame (static
-  for bodies welded to the world, over time for the rest); ``world/<body>/<geom>`` its shapes.
-  ``world/contacts/<set>`` the recorded contact points, ``world/contacts/guards`` where a
-  guard stopped an effector (at the sensing fingertip), ``world/fits/<set>`` fitted planes
-  and superquadrics.
-- ``robot/joints/<finger>`` four joint angles (rad), ``robot/tendons/<finger>`` eight tendon
-  tensions (N).
-- ``tactile/<finger>``: the 16x16 depths (m), fingertip up, seen from the object.
-- ``events/log``: a text log of starts, ends, contacts, warnings and the criteria;
-  ``events/lanes/<event>``: ``running`` while a run of the event executes (a called script's
-  events: ``events/lanes/<script stem>.<event>``).
+- ``world``: the scene, z up, every geometry solid. ``world/<body>`` holds a body's pose in
+  the world frame: ``world/arm/link2``, ``world/hand/index_distal``, a scene object by its
+  alias (``world/bulb``), ``world/scene/<body>`` for the rest; ``world/<body>/<geom>`` its
+  shapes (``world/hand/index_distal/pad``). ``world/contacts/guards/<n>`` where a guard
+  stopped an effector (shown for two seconds), ``world/contacts/<set>`` the recorded contact
+  points, ``world/fits/<set>`` fitted planes and superquadrics.
+- ``robot/hand/<finger>`` four joint angles (rad), ``robot/arm`` the six PUMA joints (rad),
+  ``robot/tendons/<finger>`` eight tendon tensions (N).
+- ``tactile/<finger>``: the 16x16 depths in mm, fingertip up, seen from the object, side by
+  side; ``tactile/key`` the depth colour scale and the plots' colours.
+- ``task/<criterion>``: what the scene's criteria measure, over the run.
+- ``events/log``: a text log of starts, ends, contacts, warnings and the criteria.
+- ``<NN>_<event>``: the event lanes (:mod:`dial.recording.lanes`).
 
 Two timelines: ``sim_time`` (simulated time) and ``tick`` (the absolute tick).
-Body poses, joints, tensions and tactile images are sent as columns in batches of frames:
-one call per entity per batch keeps the cost per frame to an array copy.
+Body poses, joints, tensions, tactile images and measurements are sent as columns in batches
+of frames: one call per entity per batch keeps the cost per frame to an array copy.
 """
 
 from __future__ import annotations
 
 import socket
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
 import mujoco
 import numpy as np
 import rerun as rr
-import rerun.blueprint as rrb
 
 from dial.backend.model import FINGERS
 from dial.backend.snapshot import FloatArray
 from dial.errors import DialError
+from dial.recording import layout
 from dial.recording.frames import Batch
-from dial.recording.geometry import (
-    Camera,
-    Shape,
-    body_names,
-    moving_bodies,
-    shapes,
-    superquadric_mesh,
-)
-from dial.recording.timeline import describe, qualified_event, when
+from dial.recording.geometry import Shape, body_paths, moving_bodies, shapes, superquadric_mesh
+from dial.recording.lanes import STATE_COLORS, LanePlan, Lanes, Phase
+from dial.recording.task import Series
+from dial.recording.timeline import describe, when
 
 APP_ID = "dial"
-TACTILE_RANGE = (0.0, 1e-3)  # m; a firm press is 0.5-1 mm deep
+TACTILE_MM = 1.0  # the colour scale's top: a firm press is 0.5-1 mm deep
+TACTILE_GAP = 3  # taxels between two fingertips' images
 JOINTS = ("abd", "mcp", "pip", "dip")
-LEVELS = {
-    "info": rr.TextLogLevel.INFO,
-    "warn": rr.TextLogLevel.WARN,
-    "error": rr.TextLogLevel.ERROR,
-}
+JOINT_COLORS = ((255, 202, 40), (239, 83, 80), (102, 187, 106), (66, 165, 245))
+EXTENSOR_SHADE = 0.55  # an extensor is drawn in its joint's colour, darker
+ARM_COLORS = [(239, 83, 80), (255, 167, 38), (255, 238, 88), (102, 187, 106), (66, 165, 245)]
+ARM_COLORS += [(171, 71, 188)]
+TASK_COLOR = (255, 255, 255)
+GUARD_COLOR, POINT_COLOR, FIT_COLOR = (255, 80, 40), (40, 160, 255), (255, 200, 0, 140)
+GUARD_SHOWN_S = 2.0  # simulated seconds a guard's contact marker stays
+LEVELS = {"info": "INFO", "warn": "WARN", "error": "ERROR"}  # rerun's TextLogLevel
 SOLID = rr.components.FillMode.Solid
 PLANE_THICKNESS = 1e-3  # m, to draw a fitted plane as a thin box
 VIEWER_PORT = 9876  # rerun's default
 FLUSH_TIMEOUT_S = 10.0
-
-
-def blueprint(camera: Camera | None) -> rrb.Blueprint:
-    """The scene and event lanes on the left; tactile, joints, tendons and the log on the right."""
-    eye = None
-    if camera is not None:
-        eye = rrb.EyeControls3D(
-            position=camera.position(), look_target=camera.lookat, eye_up=(0.0, 0.0, 1.0)
-        )
-    return rrb.Blueprint(
-        rrb.Horizontal(
-            rrb.Vertical(
-                rrb.Spatial3DView(origin="world", name="scene", eye_controls=eye),
-                rrb.StateTimelineView(origin="events/lanes", name="events"),
-                row_shares=[3, 1],
-            ),
-            rrb.Vertical(
-                rrb.Horizontal(
-                    *(
-                        rrb.Spatial2DView(origin=f"tactile/{f}", name=f"{f} tactile")
-                        for f in FINGERS
-                    )
-                ),
-                rrb.TimeSeriesView(origin="robot/joints", name="joint angles (rad)"),
-                rrb.TimeSeriesView(origin="robot/tendons", name="tendon tensions (N)"),
-                rrb.TextLogView(origin="events/log", name="log"),
-            ),
-            column_shares=[3, 2],
-        ),
-        collapse_panels=True,
-    )
 
 
 def _listening(port: int) -> bool:
@@ -117,7 +88,11 @@ def _archetype(shape: Shape) -> Any:
         return rr.Ellipsoids3D(half_sizes=[size], colors=color, fill_mode=SOLID)
     if shape.kind == "capsule":  # rerun's capsule starts at the origin; MuJoCo's is centred
         return rr.Capsules3D(
-            lengths=[2 * half], radii=[r], translations=[[0.0, 0.0, -half]], colors=color
+            lengths=[2 * half],
+            radii=[r],
+            translations=[[0.0, 0.0, -half]],
+            colors=color,
+            fill_mode=SOLID,
         )
     if shape.kind == "cylinder":
         return rr.Cylinders3D(lengths=[2 * half], radii=[r], colors=color, fill_mode=SOLID)
@@ -125,6 +100,11 @@ def _archetype(shape: Shape) -> Any:
     return rr.Mesh3D(
         vertex_positions=shape.vertices, triangle_indices=shape.faces, albedo_factor=color
     )
+
+
+def _shade(color: tuple[int, int, int], factor: float) -> tuple[int, int, int]:
+    r, g, b = (round(c * factor) for c in color)
+    return (r, g, b)
 
 
 class RerunSink:
@@ -152,41 +132,123 @@ class RerunSink:
             raise DialError(f"cannot write the recording: {e}") from e
         self.batch = 25 if spawn else 250  # frames per send: live viewers want them sooner
         self.live = spawn
+        self.lanes = Lanes()
         self._bodies: list[str] = []
+        self._task: list[str] = []
+        self._lanes_seen: set[tuple[str, ...]] = set()
+        # Text lines and lane changes wait for the next batch of frames: one call per entity.
+        self._lines: list[tuple[int, int, str, str]] = []  # ns, tick, text, level
+        self._changes: dict[str, list[tuple[int, int, str]]] = {}  # lane: ns, tick, state
         self._points: dict[str, list[FloatArray]] = {}
+        self._guards = 0
 
     # -- once ---------------------------------------------------------------------------------
     def scene(
-        self, model: mujoco.MjModel, data: mujoco.MjData, title: str, camera: Camera | None
+        self,
+        model: mujoco.MjModel,
+        data: mujoco.MjData,
+        title: str,
+        eye: tuple[layout.Vec3, layout.Vec3] | None,
+        objects: Mapping[str, str],
+        task: Sequence[Series] = (),
+        plan: LanePlan | None = None,
     ) -> None:
-        """Static geometry and the blueprint; ``data`` gives the poses of fixed bodies."""
+        """Static geometry, series styles and the layout; ``data`` gives the fixed bodies'
+        poses, ``objects`` the scene's object aliases, ``plan`` the script's event lanes."""
         rec = self.rec
+        self.lanes = Lanes(plan)
+        self._task = [f"{layout.TASK}/{s.name}" for s in task]
         rec.send_recording_name(title)
-        rec.send_blueprint(blueprint(camera))
+        titles = [(s.name, f"{s.label} ({s.unit})") for s in task]
+        rec.send_blueprint(layout.blueprint(eye, titles))
         rec.log("world", rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
-        names = body_names(model)
-        names[0] = "static"  # the world body's own geoms: the PUMA's pedestal
+        paths = [f"world/{p}" for p in body_paths(model, objects)]
         moving = set(moving_bodies(model).tolist())
-        self._bodies = [f"world/{names[b]}" for b in sorted(moving)]
+        self._bodies = [paths[b] for b in sorted(moving)]
         for b in range(1, model.nbody):
             if b not in moving:
                 pose = rr.Transform3D(translation=data.xpos[b], quaternion=_quat(data.xquat[b]))
-                rec.log(f"world/{names[b]}", pose, static=True)
+                rec.log(paths[b], pose, static=True)
         for shape in shapes(model):
             pose = rr.Transform3D(translation=shape.pos, quaternion=_quat(shape.quat))
-            rec.log(f"world/{names[shape.body]}/{shape.name}", pose, _archetype(shape), static=True)
+            rec.log(f"{paths[shape.body]}/{shape.name}", pose, _archetype(shape), static=True)
+        self._styles(task)
+        self._tactile_key()
+
+    def _styles(self, task: Sequence[Series]) -> None:
+        """Series names and colours: a joint's colour is the same in every finger's plot."""
+        rec = self.rec
         for finger in FINGERS:
-            names4 = [f"{finger} {j}" for j in JOINTS]
-            rec.log(f"robot/joints/{finger}", rr.SeriesLines(names=names4), static=True)
-            tendons = [f"{n} {k}" for n in names4 for k in ("flexor", "extensor")]
-            rec.log(f"robot/tendons/{finger}", rr.SeriesLines(names=tendons), static=True)
-            depth = rr.DepthImage.from_fields(
-                format=rr.components.ImageFormat(16, 16, channel_datatype="F32"),
-                meter=1.0,
-                colormap="Viridis",
-                depth_range=TACTILE_RANGE,
+            names = [f"{finger} {j}" for j in JOINTS]
+            rec.log(
+                f"{layout.HAND_JOINTS}/{finger}",
+                rr.SeriesLines(names=names, colors=JOINT_COLORS),
+                static=True,
             )
-            rec.log(f"tactile/{finger}", depth, static=True)
+            tendons = [f"{n} {k}" for n in names for k in ("flexor", "extensor")]
+            shades = [_shade(c, f) for c in JOINT_COLORS for f in (1.0, EXTENSOR_SHADE)]
+            rec.log(
+                f"{layout.TENDONS}/{finger}",
+                rr.SeriesLines(names=tendons, colors=shades),
+                static=True,
+            )
+        arm = [f"joint {i}" for i in range(1, 7)]
+        rec.log(layout.ARM_JOINTS, rr.SeriesLines(names=arm, colors=ARM_COLORS), static=True)
+        for path, s in zip(self._task, task, strict=True):
+            line = rr.SeriesLines(names=[f"{s.label} ({s.unit})"], colors=[TASK_COLOR], widths=2)
+            rec.log(path, line, static=True)
+
+    def _tactile_key(self) -> None:
+        """The four fingertips, two by two, with their depth scale; the plots' colour key."""
+        rec, key = self.rec, layout.KEY
+        depth: dict[str, Any] = {"meter": 1000.0, "colormap": "Viridis"}
+        depth["depth_range"] = (0.0, TACTILE_MM)
+        corners = [[18.0 * (f % 2), 20.0 * (f // 2)] for f in range(len(FINGERS))]
+        for (x, y), finger in zip(corners, FINGERS, strict=True):
+            path = f"{layout.TACTILE}/{finger}"
+            rec.log(path, rr.Transform3D(translation=[x, y, 0.0]), static=True)
+            image = rr.components.ImageFormat(16, 16, channel_datatype="F32")
+            rec.log(path, rr.DepthImage.from_fields(format=image, **depth), static=True)
+        rec.log(
+            f"{key}/fingers",
+            rr.Boxes2D(mins=corners, sizes=[[16, 16]] * 4, colors=[(90, 90, 90)] * 4),
+            static=True,
+        )
+        names = [[x + 8.0, y + 16.3] for x, y in corners]
+        rec.log(
+            f"{key}/names",
+            rr.Points2D(names, radii=0.01, labels=list(FINGERS), show_labels=True),
+            static=True,
+        )
+        x = 35.0
+        scale = np.linspace(TACTILE_MM, 0.0, 36, dtype=np.float32).reshape(36, 1)
+        rec.log(f"{key}/scale", rr.Transform3D(translation=[x, 0.0, 0.0]), static=True)
+        rec.log(f"{key}/scale", rr.DepthImage(scale, **depth), static=True)
+        ticks = [[x + 3.0, 0.5], [x + 3.0, 18.0], [x + 3.0, 35.5]]
+        labels = [f"{TACTILE_MM:g} mm", f"{TACTILE_MM / 2:g} mm", "0 mm"]
+        rec.log(
+            f"{key}/ticks",
+            rr.Points2D(ticks, radii=0.01, labels=labels, show_labels=True),
+            static=True,
+        )
+        swatches = [
+            *zip(JOINTS, JOINT_COLORS, strict=True),
+            ("extensor darker", _shade((200, 200, 200), EXTENSOR_SHADE)),
+            ("guard contact", GUARD_COLOR),
+            ("touched point", POINT_COLOR),
+        ]
+        rec.log(  # a bar of each colour, its name below it
+            f"{key}/colours",
+            rr.Boxes2D(
+                mins=[[44.0, i * 5.0 + 0.3] for i in range(len(swatches))],
+                sizes=[[14.0, 0.6]] * len(swatches),
+                colors=[c for _, c in swatches],
+                labels=[name for name, _ in swatches],
+                show_labels=True,
+                radii=0.3,
+            ),
+            static=True,
+        )
 
     # -- over time ----------------------------------------------------------------------------
     def frames(self, batch: Batch) -> None:
@@ -196,52 +258,113 @@ class RerunSink:
             rr.TimeColumn("sim_time", duration=batch.time_ns.astype("timedelta64[ns]")),
             rr.TimeColumn("tick", sequence=batch.tick),
         ]
+
+        def scalars(path: str, values: FloatArray) -> None:
+            rec.send_columns(path, indexes=index, columns=rr.Scalars.columns(scalars=values))
+
         for k, path in enumerate(self._bodies):
             poses = rr.Transform3D.columns(translation=batch.pos[:, k], quaternion=batch.quat[:, k])
             rec.send_columns(path, indexes=index, columns=poses)
         for f, finger in enumerate(FINGERS):
-            joints = batch.joints[:, 4 * f : 4 * f + 4]
-            tensions = batch.tensions[:, 8 * f : 8 * f + 8]
+            scalars(f"{layout.HAND_JOINTS}/{finger}", batch.joints[:, 4 * f : 4 * f + 4])
+            scalars(f"{layout.TENDONS}/{finger}", batch.tensions[:, 8 * f : 8 * f + 8])
+            # Rows run proximal to distal: flip them to show the fingertip up. Depths in mm.
+            pixels = np.ascontiguousarray(1000.0 * batch.tactile[:, f, ::-1, :], dtype=np.float32)
             rec.send_columns(
-                f"robot/joints/{finger}", indexes=index, columns=rr.Scalars.columns(scalars=joints)
-            )
-            rec.send_columns(
-                f"robot/tendons/{finger}",
-                indexes=index,
-                columns=rr.Scalars.columns(scalars=tensions),
-            )
-            # Rows run proximal to distal: flip them to show the fingertip up.
-            pixels = np.ascontiguousarray(batch.tactile[:, f, ::-1, :], dtype=np.float32)
-            rec.send_columns(
-                f"tactile/{finger}",
+                f"{layout.TACTILE}/{finger}",
                 indexes=index,
                 columns=rr.DepthImage.columns(buffer=pixels.reshape(n, -1).view(np.uint8)),
             )
+        scalars(layout.ARM_JOINTS, batch.arm)
+        for s, path in enumerate(self._task):
+            scalars(path, batch.task[:, s : s + 1])
+        self._phases(self.lanes.flush(float(batch.time_ns[-1]) * 1e-9))
+        self._send_events()
+
+    def _send_events(self) -> None:
+        """The text lines and lane changes gathered since the last batch, as columns."""
+
+        def index(rows: list[Any]) -> list[rr.TimeColumn]:
+            ns = np.array([r[0] for r in rows], dtype=np.int64)
+            return [
+                rr.TimeColumn("sim_time", duration=ns.astype("timedelta64[ns]")),
+                rr.TimeColumn("tick", sequence=[r[1] for r in rows]),
+            ]
+
+        if self._lines:
+            lines, self._lines = self._lines, []
+            texts = rr.TextLog.columns(text=[r[2] for r in lines], level=[r[3] for r in lines])
+            self.rec.send_columns(layout.LOG, indexes=index(lines), columns=texts)
+        changes, self._changes = self._changes, {}
+        for path, rows in changes.items():
+            states = rr.StateChange.columns(state=[r[2] for r in rows])
+            self.rec.send_columns(path, indexes=index(rows), columns=states)
 
     def record(self, record: Mapping[str, Any], tick: int, tips: FloatArray | None) -> None:
         """One log record at its own simulated time; ``tips`` (4, 3) m locate guard contacts."""
-        rec = self.rec
         t, tick = when(record, tick)
-        rec.set_time("sim_time", duration=np.timedelta64(round(t * 1e9), "ns"))
-        rec.set_time("tick", sequence=tick)
+        self._at(t, tick)
         described = describe(record)
         if described is not None:
             text, level = described
-            rec.log("events/log", rr.TextLog(text, level=LEVELS[level]))
+            self._lines.append((round(t * 1e9), tick, text, LEVELS[level]))
         kind = record["kind"]
-        if kind == "start":
-            rec.log(f"events/lanes/{qualified_event(record)}", rr.StateChange(state="running"))
-        elif kind == "end":
-            rec.log(f"events/lanes/{qualified_event(record)}", rr.StateChange.cleared())
+        if kind == "end":
             self._sensed(record.get("data", {}))
         elif kind == "contact" and tips is not None:
-            self._point("guards", tips[FINGERS.index(record["finger"])], (255, 80, 40))
+            self._guard(record, tips[FINGERS.index(record["finger"])], t, tick)
+        self._phases(self.lanes.feed(record))
+
+    def _at(self, t: float, tick: int) -> None:
+        self.rec.set_time("sim_time", duration=np.timedelta64(round(t * 1e9), "ns"))
+        self.rec.set_time("tick", sequence=tick)
+
+    def _phases(self, phases: list[Phase]) -> None:
+        """Lane changes, each at its own time; a lane's first change brings its colours."""
+        for phase in phases:
+            path = rr.new_entity_path(list(phase.lane))
+            if phase.lane not in self._lanes_seen:
+                self._lanes_seen.add(phase.lane)
+                config = rr.StateConfiguration(
+                    values=list(STATE_COLORS),
+                    colors=np.array(
+                        [
+                            (r << 24) | (g << 16) | (b << 8) | 0xFF
+                            for r, g, b in STATE_COLORS.values()
+                        ],
+                        dtype=np.uint32,
+                    ),
+                )
+                self.rec.log(path, config, static=True)
+            self._at(phase.t, phase.tick)
+            state = (
+                rr.StateChange.cleared()
+                if phase.state is None
+                else rr.StateChange(state=phase.state)
+            )
+            self.rec.log(path, state)
+
+    def _guard(self, record: Mapping[str, Any], tip: FloatArray, t: float, tick: int) -> None:
+        """A guard's contact at the sensing fingertip, labelled, shown for GUARD_SHOWN_S."""
+        self._guards += 1
+        path = f"world/contacts/guards/{self._guards:02d}"
+        unit = "N" if record["sensor"] == "force" else "m"
+        label = f"{record['finger']} {record['sensor']} {record['value']:.3g} {unit}"
+        self.rec.log(path, rr.Points3D([tip], radii=0.006, colors=GUARD_COLOR, labels=[label]))
+        self._at(t + GUARD_SHOWN_S, tick)
+        self.rec.log(path, rr.Clear(recursive=False))
+        self._at(t, tick)
 
     def _sensed(self, data: Mapping[str, Any]) -> None:
         """Contact points and fits carried by an ``end`` record's data."""
         name = str(data.get("set", "points"))
         if "point" in data:
-            self._point(name, np.asarray(data["point"]), (40, 160, 255))
+            points = self._points.setdefault(name, [])
+            points.append(np.asarray(data["point"]))
+            self.rec.log(
+                f"world/contacts/{name}",
+                rr.Points3D(points, radii=0.004, colors=POINT_COLOR, labels=[name] * len(points)),
+            )
         elif "normal" in data:
             axes = np.asarray(data["axes"])
             rot = np.stack([axes[0], axes[1], np.asarray(data["normal"])], axis=1)
@@ -251,7 +374,7 @@ class RerunSink:
                 rr.Transform3D(translation=data["centroid"], mat3x3=rot),
                 rr.Boxes3D(
                     half_sizes=[[extents[0], extents[1], PLANE_THICKNESS / 2]],
-                    colors=(255, 200, 0, 140),
+                    colors=FIT_COLOR,
                     fill_mode=SOLID,
                 ),
             )
@@ -261,18 +384,13 @@ class RerunSink:
                 f"world/fits/{name}",
                 rr.Transform3D(translation=data["centre"], mat3x3=np.asarray(data["rotation"])),
                 rr.Mesh3D(
-                    vertex_positions=vertices,
-                    triangle_indices=faces,
-                    albedo_factor=(255, 200, 0, 140),
+                    vertex_positions=vertices, triangle_indices=faces, albedo_factor=FIT_COLOR
                 ),
             )
 
-    def _point(self, name: str, point: FloatArray, color: tuple[int, int, int]) -> None:
-        points = self._points.setdefault(name, [])
-        points.append(point)
-        self.rec.log(f"world/contacts/{name}", rr.Points3D(points, radii=0.004, colors=color))
-
     def close(self) -> None:
+        self._phases(self.lanes.flush())
+        self._send_events()
         # A viewer closed mid-run must not keep the run from ending.
         self.rec.flush(timeout_sec=FLUSH_TIMEOUT_S if self.live else 1e38)
         self.rec.disconnect()

@@ -15,8 +15,8 @@ from typing import Any
 import mujoco
 
 from dial.engine import RunResult, Watched
+from dial.engine.observe import every, first_line
 from dial.errors import DialError
-from dial.recording.frames import every
 from dial.recording.geometry import Camera, task_camera
 from dial.recording.observers import object_bodies
 
@@ -38,16 +38,17 @@ def video_problem(path: str) -> str | None:
     return None
 
 
-def first_line(e: BaseException) -> str:
-    return (str(e).strip().splitlines() or [type(e).__name__])[0]
-
-
 class Renderer:
-    """Frames of the scene from a fixed camera, as (HEIGHT, WIDTH, 3) uint8 RGB arrays."""
+    """Frames of the scene from a fixed camera, as (height, width, 3) uint8 RGB arrays."""
 
-    def __init__(self, model: mujoco.MjModel, camera: Camera) -> None:
+    def __init__(
+        self, model: mujoco.MjModel, camera: Camera, width: int = WIDTH, height: int = HEIGHT
+    ) -> None:
+        # A frame larger than the model's offscreen buffer needs a larger buffer.
+        model.vis.global_.offwidth = max(int(model.vis.global_.offwidth), width)
+        model.vis.global_.offheight = max(int(model.vis.global_.offheight), height)
         try:
-            self.renderer = mujoco.Renderer(model, HEIGHT, WIDTH)
+            self.renderer = mujoco.Renderer(model, height, width)
         except Exception as e:  # the GL backends raise assorted errors
             raise DialError(
                 f"cannot render offscreen ({first_line(e)}); on Linux without a display, "
@@ -72,6 +73,8 @@ class Renderer:
 
 class VideoWriter:
     """Writes a frame every ``1 / fps`` s of simulated time (rounded to whole periods)."""
+
+    what = "the video writer"  # how messages name it
 
     def __init__(self, path: Path, fps: float = VIDEO_FPS) -> None:
         self.path, self.fps = path, fps

@@ -12,11 +12,10 @@ import sys
 from typing import Any
 
 from dial.engine import RunResult, Watched
+from dial.engine.observe import every, first_line
 from dial.errors import DialError
-from dial.recording.frames import every
 from dial.recording.geometry import task_camera
 from dial.recording.observers import object_bodies
-from dial.recording.video import first_line
 
 VIEWER_HZ = 60.0  # screen updates per second of simulated (here also wall-clock) time
 
@@ -47,6 +46,8 @@ def _probe_glfw() -> None:
 
 
 class PassiveViewer:
+    what = "MuJoCo's viewer"  # how messages name it
+
     def begin(self, run: Watched) -> None:
         _probe_glfw()
         import mujoco.viewer
@@ -69,6 +70,11 @@ class PassiveViewer:
     def period(self, periods: int, tick: int) -> None:
         # A closed window ends the watching, not the run.
         if periods % self.every == 0 and self.handle.is_running():
+            self.handle.sync()
+
+    def show_now(self) -> None:
+        """A paused run: show this moment."""
+        if self.handle.is_running():
             self.handle.sync()
 
     def end(self, result: RunResult | None) -> None:

@@ -67,18 +67,20 @@ class Above(Criterion):
 
 @dataclass(frozen=True)
 class FingerContacts(Criterion):
-    """At least ``min`` fingers touch the object. A finger is every body whose name starts with
-    one of ``fingers`` (body-name prefixes, one per finger)."""
+    """At least ``min`` fingers touch the object, pressing it with at most ``max_force`` N of
+    normal contact force in all (a light touch, not a crash). A finger is every body whose
+    name starts with one of ``fingers`` (body-name prefixes, one per finger)."""
 
     kind = "finger_contacts"
     body: str = field(metadata={"key": "object"})
     fingers: tuple[str, ...]
     min: int = 2
+    max_force: float = math.inf
 
     def check(self) -> str | None:
         if not 1 <= self.min <= len(self.fingers):
             return f"min must be from 1 to the number of fingers ({len(self.fingers)})"
-        return None
+        return None if self.max_force > 0 else "max_force must be above 0 N"
 
 
 @dataclass(frozen=True)

@@ -12,6 +12,7 @@ from __future__ import annotations
 import fnmatch
 import math
 from collections.abc import Callable, Iterable, Mapping
+from dataclasses import dataclass
 from typing import Any
 
 import mujoco
@@ -45,45 +46,115 @@ def measure(
     return _MEASURES[type(criterion)](criterion, model, data, results)
 
 
-def _fraction_in_region(
-    c: FractionInRegion, m: mujoco.MjModel, d: mujoco.MjData, _: Results
-) -> tuple[bool, str]:
+@dataclass(frozen=True)
+class Reading:
+    """What a criterion measures in the current state, as a number to plot over a run:
+    ``quantity`` of the body ``subject`` (``height`` of ``lightbulb_bulb``) in ``unit``."""
+
+    subject: str
+    quantity: str
+    value: float
+    unit: str
+
+
+def reading(criterion: Criterion, model: mujoco.MjModel, data: mujoco.MjData) -> Reading | None:
+    """The criterion's measured quantity now; None for those that judge a fit's result."""
+    read = reader(criterion, model)
+    return None if read is None else read(data)
+
+
+def reader(
+    criterion: Criterion, model: mujoco.MjModel
+) -> Callable[[mujoco.MjData], Reading] | None:
+    """:func:`reading` with the criterion's bodies looked up once, to sample a run often."""
+    if isinstance(criterion, FractionInRegion):
+        bodies = _region_bodies(criterion, model)
+        site = model.site(criterion.region)
+        cup = model.body(model.site_bodyid[site.id]).name
+        return lambda d: Reading(cup, "contents", _inside(criterion, model, d, bodies)[0], "bodies")
+    read = _READINGS.get(type(criterion))
+    return None if read is None else lambda d: read(criterion, model, d)
+
+
+def _region_bodies(c: FractionInRegion, m: mujoco.MjModel) -> list[int]:
     bodies = [i for i in range(m.nbody) if fnmatch.fnmatchcase(m.body(i).name, c.bodies)]
     if not bodies:
         raise ValueError(f"criterion {c.name}: no body matches '{c.bodies}'")
+    return bodies
+
+
+def _inside(
+    c: FractionInRegion, m: mujoco.MjModel, d: mujoco.MjData, bodies: list[int] | None = None
+) -> tuple[int, int]:
+    """How many of the matching bodies lie in the region, and how many match."""
+    bodies = _region_bodies(c, m) if bodies is None else bodies
     site = m.site(c.region)
     if site.type[0] != mujoco.mjtGeom.mjGEOM_BOX:
         raise ValueError(f"criterion {c.name}: region site '{c.region}' must be a box")
     local = (d.xpos[bodies] - d.site_xpos[site.id]) @ d.site_xmat[site.id].reshape(3, 3)
-    inside = int(np.all(np.abs(local) <= site.size, axis=1).sum())
-    fraction = inside / len(bodies)
-    return fraction >= c.min, f"{inside}/{len(bodies)} in {c.region} (min {c.min:.0%})"
+    return int(np.all(np.abs(local) <= site.size, axis=1).sum()), len(bodies)
+
+
+def _fraction_in_region(
+    c: FractionInRegion, m: mujoco.MjModel, d: mujoco.MjData, _: Results
+) -> tuple[bool, str]:
+    inside, total = _inside(c, m, d)
+    return inside / total >= c.min, f"{inside}/{total} in {c.region} (min {c.min:.0%})"
+
+
+def _tilt(c: Upright, m: mujoco.MjModel, d: mujoco.MjData) -> float:
+    """The object's tilt from upright, rad."""
+    z = d.xmat[m.body(c.body).id].reshape(3, 3)[:, 2]
+    return math.acos(float(np.clip(z[2], -1.0, 1.0)))
 
 
 def _upright(c: Upright, m: mujoco.MjModel, d: mujoco.MjData, _: Results) -> tuple[bool, str]:
-    z = d.xmat[m.body(c.body).id].reshape(3, 3)[:, 2]
-    tilt = math.acos(float(np.clip(z[2], -1.0, 1.0)))
+    tilt = _tilt(c, m, d)
     return tilt <= c.max_tilt, f"tilt {math.degrees(tilt):.1f} deg"
 
 
+def _height(c: Above, m: mujoco.MjModel, d: mujoco.MjData) -> float:
+    """The object's origin above the site, m."""
+    return float(d.xpos[m.body(c.body).id, 2] - d.site_xpos[m.site(c.site).id, 2])
+
+
 def _above(c: Above, m: mujoco.MjModel, d: mujoco.MjData, _: Results) -> tuple[bool, str]:
-    height = float(d.xpos[m.body(c.body).id, 2] - d.site_xpos[m.site(c.site).id, 2])
+    height = _height(c, m, d)
     return height >= c.min_height, f"{height * 1000:.1f} mm above {c.site}"
+
+
+def _touching(
+    c: FingerContacts, m: mujoco.MjModel, d: mujoco.MjData, force: bool = False
+) -> tuple[set[str], float]:
+    """The finger prefixes whose bodies touch the object; with ``force``, also the normal
+    force they press it with in all (N; else 0)."""
+    target = m.body(c.body).id
+    bodies = m.geom_bodyid[d.contact.geom[: d.ncon]]  # (ncon, 2): one read of the contacts
+    touching: set[str] = set()
+    total = 0.0
+    wrench = np.zeros(6)
+    for i in np.flatnonzero((bodies == target).any(axis=1)):
+        b1, b2 = bodies[i]
+        other = m.body(int(b2 if b1 == target else b1)).name
+        fingers = [p for p in c.fingers if other.startswith(p)]
+        if fingers:
+            touching.update(fingers)
+            if force:
+                mujoco.mj_contactForce(m, d, int(i), wrench)
+                total += abs(float(wrench[0]))  # the normal component, in the contact frame
+    return touching, total
 
 
 def _finger_contacts(
     c: FingerContacts, m: mujoco.MjModel, d: mujoco.MjData, _: Results
 ) -> tuple[bool, str]:
-    target = m.body(c.body).id
-    touching: set[str] = set()
-    for contact in d.contact[: d.ncon]:
-        b1, b2 = m.geom_bodyid[contact.geom1], m.geom_bodyid[contact.geom2]
-        if target not in (b1, b2):
-            continue
-        other = m.body(b2 if b1 == target else b1).name
-        touching.update(p for p in c.fingers if other.startswith(p))
+    touching, force = _touching(c, m, d, force=not math.isinf(c.max_force))
     names = ", ".join(sorted(touching)) or "none"
-    return len(touching) >= c.min, f"{len(touching)} fingers touch ({names})"
+    detail = f"{len(touching)} fingers touch ({names})"
+    if math.isinf(c.max_force):
+        return len(touching) >= c.min, detail
+    held = len(touching) >= c.min and force <= c.max_force
+    return held, f"{detail} with {force:.1f} N (max {c.max_force:g} N)"
 
 
 def _plane_fit(c: PlaneFit, m: mujoco.MjModel, d: mujoco.MjData, r: Results) -> tuple[bool, str]:
@@ -156,6 +227,12 @@ def _vector(fit: Mapping[str, Any], key: str, n: int) -> np.ndarray:
         raise ValueError(f"fit result '{key}' must be {n} finite numbers, got {fit.get(key)!r}")
     return value
 
+
+_READINGS: dict[type, Callable[[Any, mujoco.MjModel, mujoco.MjData], Reading]] = {
+    Upright: lambda c, m, d: Reading(c.body, "tilt", math.degrees(_tilt(c, m, d)), "deg"),
+    Above: lambda c, m, d: Reading(c.body, "height", 1000 * _height(c, m, d), "mm"),
+    FingerContacts: lambda c, m, d: Reading(c.body, "touch", len(_touching(c, m, d)[0]), "fingers"),
+}
 
 _MEASURES: dict[type, Callable[[Any, mujoco.MjModel, mujoco.MjData, Results], tuple[bool, str]]]
 _MEASURES = {

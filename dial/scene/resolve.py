@@ -6,6 +6,7 @@ Bundled world files are ``<models_dir>/utah_hand_puma/worlds/<name>.toml``.
 
 from __future__ import annotations
 
+from contextlib import suppress
 from pathlib import Path
 
 from dial.instructions.scene_names import SceneNotFoundError
@@ -37,7 +38,9 @@ def resolve_scene(scene: str, base_dir: Path) -> Path:
     An existing file (absolute, or relative to ``base_dir``) wins; otherwise ``scene`` must be
     a bundled scene name. Raises :class:`SceneNotFoundError` listing the bundled names.
     """
-    candidate = Path(scene).expanduser()
+    candidate = Path(scene)
+    with suppress(RuntimeError):  # '~user' of no such user: not a path; perhaps a bundled name
+        candidate = candidate.expanduser()
     if not candidate.is_absolute():
         candidate = base_dir / candidate
     if candidate.is_file():
@@ -49,3 +52,18 @@ def resolve_scene(scene: str, base_dir: Path) -> Path:
         f"unknown scene '{scene}': neither a file (relative to the script) nor a bundled "
         f"scene; bundled scenes: {', '.join(names)}"
     )
+
+
+def scene_option(arg: str) -> str:
+    """``--scene`` as every script it reaches should see it: an existing world file (as an
+    absolute path, so that it means the same from every called script) or a bundled name.
+    Raises :class:`SceneNotFoundError` listing the bundled names."""
+    if Path(arg).is_file():
+        return str(Path(arg).resolve())
+    names = bundled_scene_names()
+    if arg not in names:
+        raise SceneNotFoundError(
+            f"--scene: '{arg}' is neither a file nor a bundled scene; "
+            f"bundled scenes: {', '.join(names)}"
+        )
+    return arg

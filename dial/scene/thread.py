@@ -26,6 +26,10 @@ class Thread:
     turn_qpos: int  # qpos address of the turn hinge
     release_turn: float  # rad; turn at which the weld lets go
 
+    def turn(self, data: mujoco.MjData) -> float:
+        """How far the object is unscrewed, rad (the turn hinge's position)."""
+        return float(data.qpos[self.turn_qpos])
+
     def engaged(self, data: mujoco.MjData) -> bool:
         return bool(data.eq_active[self.weld])
 

@@ -10,19 +10,21 @@ import math
 import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass
+from difflib import get_close_matches
 from pathlib import Path
 from types import MappingProxyType
 from typing import Any, Literal
 
+from dial.instructions.limits import drive_problem, hand_problem
 from dial.instructions.scene_names import SceneNames
 from dial.instructions.types import FINGERS
 from dial.scene.criteria import Criterion, parse_criterion
+from dial.scene.mjcf import body_names
 from dial.scene.reader import Reader, WorldFileError
 from dial.scene.resolve import resolve_scene
-from dial.scene.valii import NAME, Appro, Move, Statement, StatementError, parse_statement
+from dial.scene.valii import NAME, Appro, Drive, Move, Statement, StatementError, parse_statement
 
 JOINTS: tuple[str, ...] = ("abd", "mcp", "pip", "dip")  # joint j of a finger: bit 4*f + j
-MAX_JOINT_DEG = 180.0
 AXES: tuple[str, ...] = ("object", "world")
 
 
@@ -147,8 +149,26 @@ def load_world(path: Path) -> World:
 
 
 def load_scene_names(scene: str, script_dir: Path) -> SceneNames:
-    """The :data:`~dial.instructions.scene_names.SceneLoader` for the script checker."""
-    return load_world(resolve_scene(scene, script_dir)).scene_names()
+    """The :data:`~dial.instructions.scene_names.SceneLoader` for the script checker.
+
+    Beyond the world file, it reads the model (without MuJoCo): a malformed model, or an
+    object that names no body of it, is reported here rather than when a run starts.
+    """
+    world = load_world(resolve_scene(scene, script_dir))
+    check_bodies(world)
+    return world.scene_names()
+
+
+def check_bodies(world: World) -> None:
+    """Raise :class:`WorldFileError` if the model is malformed or lacks an object's body."""
+    bodies = body_names(world.model_path)
+    for alias, body in world.objects.items():
+        if body not in bodies:
+            close = get_close_matches(body, sorted(bodies), n=2)
+            hint = f"; did you mean {' or '.join(repr(c) for c in close)}?" if close else ""
+            raise WorldFileError(
+                world.path, f"objects.{alias}", f"no body '{body}' in {world.model_path.name}{hint}"
+            )
 
 
 def parse_pose(reader: Reader, name: str, table: Any) -> HandPose:
@@ -166,8 +186,9 @@ def parse_pose(reader: Reader, name: str, table: Any) -> HandPose:
             reader.keys(sub, fkey, [], JOINTS)
             joints = {j: reader.number(v, f"{fkey}.{j}") for j, v in sub.items()}
         for joint, deg in joints.items():
-            if abs(deg) > MAX_JOINT_DEG:
-                raise reader.error(f"{fkey}.{joint}", f"{deg:g} deg is beyond +-{MAX_JOINT_DEG:g}")
+            problem = hand_problem(joint, math.radians(deg))
+            if problem is not None:
+                raise reader.error(f"{fkey}.{joint}", problem)
             angles[base + JOINTS.index(joint)] = math.radians(deg)
     if not angles:
         raise reader.error(key, f"a pose must set at least one joint of {', '.join(FINGERS)}")
@@ -216,6 +237,10 @@ def _program(reader: Reader, name: str, value: Any, locations: Mapping[str, Loca
             statement = parse_statement(line, number)
         except StatementError as e:
             raise reader.error(where, str(e)) from None
+        # A stored DRIVE turning further than its joint's whole range overshoots wherever it
+        # starts (a session, such as dial teach, checks a drive against the joint's angle).
+        if isinstance(statement, Drive) and (p := drive_problem(statement.joint, statement.angle)):
+            raise reader.error(where, p)
         if isinstance(statement, Move | Appro) and statement.location not in locations:
             valid = ", ".join(locations) or "(none)"
             raise reader.error(

@@ -1,31 +1,48 @@
-"""The trio block runner: DIAL timing semantics against a small robot protocol."""
+"""The block runner: DIAL timing semantics against a small robot protocol."""
 
-from dial.scheduler.log import EventLog
+from dial.scheduler.log import EventLog, LogError
 from dial.scheduler.runner import Runner, RunSummary, periods_per_tick
+from dial.scheduler.signals import EXIT_STATUS, StopRequest, catch_stop_signals
 from dial.scheduler.types import (
+    DONE,
     Ended,
-    InstantPrimitive,
+    Fired,
+    Happening,
+    Interrupted,
+    Monitor,
     Now,
     Outcome,
     Primitive,
     PrimitiveFactory,
+    Report,
     Robot,
     RunAborted,
     RunInfo,
+    Sensor,
 )
 
 __all__ = [
+    "DONE",
+    "EXIT_STATUS",
     "Ended",
     "EventLog",
-    "InstantPrimitive",
+    "Fired",
+    "Happening",
+    "Interrupted",
+    "LogError",
+    "Monitor",
     "Now",
     "Outcome",
     "Primitive",
     "PrimitiveFactory",
+    "Report",
     "Robot",
     "RunAborted",
     "RunInfo",
     "RunSummary",
     "Runner",
+    "Sensor",
+    "StopRequest",
+    "catch_stop_signals",
     "periods_per_tick",
 ]

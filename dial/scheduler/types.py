@@ -1,7 +1,8 @@
-"""The contract between the block runner, the primitives and the robot.
+"""The contract between the runner, the primitives and the robot.
 
-The runner knows nothing of MuJoCo: it drives any :class:`Robot` and builds a
-:class:`Primitive` per run through a :data:`PrimitiveFactory`.
+The runner knows nothing of MuJoCo: it drives any :class:`Robot` over a snapshot type
+``S`` of the robot's choosing, and builds a :class:`Primitive` (or a :class:`Sensor`, for
+zero-length sensing) per run through a :data:`PrimitiveFactory`.
 """
 
 from __future__ import annotations
@@ -10,39 +11,51 @@ from abc import ABC, abstractmethod
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from enum import StrEnum
-from typing import Any, Protocol
+from typing import Generic, NamedTuple, Protocol, TypeVar
 
 from dial.errors import DialError
-from dial.parser.check import EventDef
-from dial.parser.timeline import Run
+from dial.parser.script import EventDef, Run
+
+S = TypeVar("S")
+S_co = TypeVar("S_co", covariant=True)
+S_contra = TypeVar("S_contra", contravariant=True)
+
+# What a run reports for the log: JSON-able values (numbers, strings, lists, arrays).
+Data = Mapping[str, object]
 
 
 class Outcome(StrEnum):
-    """How a run ended (DESIGN 2.5)."""
+    """How a run ended (DESIGN 2.5, 2.7)."""
 
     DONE = "done"
     MISSED = "missed"
     TIMEOUT = "timeout"
     ERROR = "error"
+    PREEMPTED = "preempted"
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class Ended:
-    """A run's outcome, with a message for ``error`` and any sensed data to log."""
+    """A run's outcome, with a message for ``error``, any sensed data to log, and warnings
+    (each becomes a ``warning`` record: a run that did not quite do what was asked never
+    ends silently ``done``)."""
 
     outcome: Outcome
     message: str = ""
-    data: Mapping[str, Any] = field(default_factory=dict)
+    data: Data = field(default_factory=dict)
+    warnings: tuple[str, ...] = ()
 
 
-@dataclass(frozen=True)
-class Now:
+DONE = Ended(Outcome.DONE)
+
+
+class Now(NamedTuple):
     """What a primitive knows of time in one control period.
 
-    ``progress`` is the run's progress through its executing ticks in **tick
-    time** (0 at its start, 1 at the end of its last ``#``/``=`` tick); it stands
-    still while a tick is stretched. ``elapsed`` is simulated time since the
-    run started, which never stands still.
+    ``progress`` is the run's progress through its executing ticks in **tick time** (0 at
+    its start, 1 at the end of its last ``#``/``=`` tick); it stands still while a tick is
+    stretched. ``elapsed`` is simulated time since the run started (s), which never does.
+    ``sim_time`` is the simulated time at the end of this period (s).
     """
 
     sim_time: float
@@ -52,41 +65,35 @@ class Now:
     stretched: bool
 
 
-class Primitive(ABC):
-    """One run of an instruction.
+class Primitive(ABC, Generic[S_contra]):
+    """One run of an instruction, stepped synchronously by the runner.
 
-    Lifecycle: :meth:`start` once, :meth:`step` every control period until it
-    returns an :class:`Ended` (or, for fixed-length runs, until the runner calls
-    :meth:`finish` at the end of the last executing tick), and :meth:`stop`
-    always, also when the run is cancelled. Steps read the immutable snapshot and
-    write only the run's own effectors' command slots.
+    Lifecycle: :meth:`start` once; :meth:`step` every control period until it returns an
+    :class:`Ended` (or, for fixed-length runs, until the runner calls :meth:`finish` at the
+    end of the last executing tick); :meth:`stop` always, exactly once, after the run ends
+    for whatever reason (done, timeout, error, preempted, abort, interrupt). A step reads
+    the immutable snapshot and writes only its own effectors' command slots.
     """
 
-    @abstractmethod
-    def start(self, snapshot: Any) -> None: ...
+    def start(self, snapshot: S_contra) -> None:
+        """Plan the run from the snapshot at its first period."""
 
     @abstractmethod
-    def step(self, snapshot: Any, now: Now) -> Ended | None: ...
+    def step(self, snapshot: S_contra, now: Now) -> Ended | None:
+        """Write this period's commands; return an outcome to end the run."""
 
-    def finish(self, snapshot: Any) -> Ended:
+    def finish(self, snapshot: S_contra) -> Ended:
         """End a fixed-length run at the end of its last executing tick."""
-        return Ended(Outcome.DONE)
+        return DONE
 
-    def stop(self) -> None:  # noqa: B027 - optional hook, most primitives need no cleanup
+    def stop(self) -> None:
         """Clean up; the effectors keep holding their last command."""
 
 
-class InstantPrimitive(Primitive):
-    """A zero-length (sensing) run: it happens at the start of its tick."""
+class Sensor(Protocol[S_contra]):
+    """A zero-length run or a condition test: sensed at once, at the start of its tick."""
 
-    @abstractmethod
-    def sense(self, snapshot: Any) -> Ended: ...
-
-    def start(self, snapshot: Any) -> None:
-        raise AssertionError("instant primitives are sensed, not started")
-
-    def step(self, snapshot: Any, now: Now) -> Ended | None:
-        raise AssertionError("instant primitives are sensed, not stepped")
+    def sense(self, snapshot: S_contra) -> Ended: ...
 
 
 @dataclass(frozen=True)
@@ -98,41 +105,100 @@ class RunInfo:
     script: str
     periods_per_tick: int
     period: float
-    instant: bool = False  # a condition-only event, sensed once with zero duration
+    instant: bool = False  # sensed once with zero duration (a sensing run or condition test)
 
 
-PrimitiveFactory = Callable[[RunInfo], Primitive]
+PrimitiveFactory = Callable[[RunInfo], "Primitive[S] | Sensor[S]"]
 
 
-class Robot(Protocol):
-    """What the runner needs of a robot backend."""
+class Happening(NamedTuple):
+    """Something the robot observed during a period, for the runner to log.
+
+    ``kind`` is the record kind (``contact``, ``thread``, ``warning``); ``fields`` its
+    fields, with the simulated time ``t`` of the physics step where it happened.
+    """
+
+    kind: str
+    fields: Data
+
+
+class Fired(NamedTuple):
+    """A monitor whose condition held at a physics step of the period."""
+
+    key: int
+    time: float
+    step: int
+
+
+class Report(NamedTuple):
+    """What happened during one control period, when anything did (else ``advance`` -> None).
+
+    ``fault``: an engine-owned safety monitor tripped (joint or tension limit, non-finite
+    state); the runner aborts. ``fired``: monitors, in the order they were armed.
+    """
+
+    fault: str | None = None
+    happenings: tuple[Happening, ...] = ()
+    fired: tuple[Fired, ...] = ()
+
+
+class Monitor(NamedTuple):
+    """A live condition the robot tests at every physics step while it is armed.
+
+    ``event`` is the watched sensing event; the robot fires when its condition holds
+    (``negated``: when it does not).
+    """
+
+    event: EventDef
+    negated: bool
+
+
+class Robot(Protocol[S_co]):
+    """What the runner needs of a robot backend. Every call is synchronous."""
 
     @property
     def period(self) -> float:
         """The control period in seconds."""
         ...
 
-    def snapshot(self) -> Any:
+    def snapshot(self) -> S_co:
         """An immutable view of the sensors for this control period."""
         ...
 
-    async def advance(self) -> str | None:
-        """Apply the command slots and simulate one control period.
-
-        Returns a message when an engine-owned safety monitor trips (joint or
-        tension limit, non-finite state); the runner then aborts.
-        """
+    def advance(self) -> Report | None:
+        """Apply the command slots and simulate one control period."""
         ...
 
     def hold_all(self) -> None:
-        """Freeze every effector at its current pose (on abort or interrupt)."""
+        """Freeze every effector where it is measured now (abort, interrupt)."""
+        ...
+
+    def hold(self, effectors: frozenset[str]) -> None:
+        """Freeze these effectors where they are measured now (preemption)."""
+        ...
+
+    def arm(self, monitor: Monitor) -> int:
+        """Start testing a monitor every physics step; returns its key."""
+        ...
+
+    def disarm(self, key: int) -> None:
+        """Stop testing a monitor."""
         ...
 
 
 class RunAborted(DialError):
-    """The script stopped: a run ended ``timeout`` or ``error``, or a loop hit its max."""
+    """The script stopped: a run ended ``timeout`` or ``error``, a loop hit its max, a
+    reaction aborted or retried too often, or a safety monitor tripped."""
 
     def __init__(self, message: str, event: str | None = None, tick: int = 0) -> None:
         super().__init__(message)
         self.event = event
         self.tick = tick
+
+
+class Interrupted(DialError):
+    """The run was stopped by a signal (SIGINT or SIGTERM); every effector holds."""
+
+    def __init__(self, signal_name: str) -> None:
+        super().__init__(f"interrupted by {signal_name}")
+        self.signal_name = signal_name

@@ -3,60 +3,104 @@
 The fake robot's effectors are single numbers: a fixed-length run writes its
 tick-time progress (0 to 1) into each of its effectors, so tests can see a
 trajectory hold its set-point while a tick is stretched. Indeterminate and
-sensing runs follow a scripted :class:`Behaviour`.
+sensing runs follow a scripted :class:`Behaviour`; a watched event's condition holds in
+the periods its ``holds`` entry lists, so tests pin the period a monitor fires in.
 """
 
 from __future__ import annotations
 
 import itertools
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Collection, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
-from pathlib import Path
 from types import MappingProxyType
-from typing import Any
+from typing import NamedTuple
 
 import trio
 import trio.testing
 
 from dial.instructions.types import EFFECTORS
-from dial.parser.check import Script, check_text
-from dial.scheduler.log import EventLog
+from dial.parser.check import check_text
+from dial.parser.script import Script
+from dial.scheduler.log import EventLog, Record
 from dial.scheduler.runner import Runner, RunSummary
-from dial.scheduler.types import Ended, InstantPrimitive, Now, Outcome, Primitive, RunInfo
+from dial.scheduler.types import (
+    Ended,
+    Fired,
+    Monitor,
+    Now,
+    Outcome,
+    Primitive,
+    Report,
+    RunInfo,
+    Sensor,
+)
 
 
-@dataclass(frozen=True)
-class FakeSnapshot:
+class FakeSnapshot(NamedTuple):
     periods: int
     commands: Mapping[str, float]
 
 
 class FakeRobot:
-    """Effectors are numbers; ``advance`` sleeps one period on trio's clock."""
+    """Effectors are numbers that follow their commands at once.
 
-    def __init__(self, period: float = 0.01, fault_at: Mapping[int, str] | None = None) -> None:
+    ``fault_at``: period -> a safety-monitor message reported in that period. ``holds``:
+    watched event -> the periods (1-based) in which its condition holds.
+    """
+
+    def __init__(
+        self,
+        period: float = 0.01,
+        fault_at: Mapping[int, str] | None = None,
+        holds: Mapping[str, Collection[int]] | None = None,
+    ) -> None:
         self._period = period
         self.commands: dict[str, float] = dict.fromkeys(EFFECTORS, 0.0)
         self.trace: list[dict[str, float]] = []  # commands applied in each period
         self.periods = 0
         self.held = False
+        self.holds_at: list[tuple[int, frozenset[str]]] = []  # (period, effectors) held
         self.fault_at = dict(fault_at or {})
+        self.conditions = dict(holds or {})
+        self.monitors: dict[int, Monitor] = {}
+        self.armed: list[tuple[int, str, bool]] = []  # (period, event, negated), as armed
+        self._keys = itertools.count(1)
+        self.stops: list[str] = []  # events whose run was stopped, in order
 
     @property
     def period(self) -> float:
         return self._period
 
     def snapshot(self) -> FakeSnapshot:
-        return FakeSnapshot(self.periods, MappingProxyType(dict(self.commands)))
+        return FakeSnapshot(self.periods, MappingProxyType(self.commands.copy()))
 
-    async def advance(self) -> str | None:
-        self.trace.append(dict(self.commands))
-        self.periods += 1
-        await trio.sleep(self._period)
-        return self.fault_at.get(self.periods)
+    def advance(self) -> Report | None:
+        self.trace.append(self.commands.copy())
+        self.periods = periods = self.periods + 1
+        fault = self.fault_at.get(periods) if self.fault_at else None
+        if not self.monitors:
+            return None if fault is None else Report(fault)
+        fired = tuple(
+            Fired(key, periods * self._period, periods)
+            for key, m in self.monitors.items()
+            if (periods in self.conditions.get(m.event.name, ())) != m.negated
+        )
+        return Report(fault, (), fired) if fault is not None or fired else None
 
     def hold_all(self) -> None:
         self.held = True
+
+    def hold(self, effectors: frozenset[str]) -> None:
+        self.holds_at.append((self.periods, effectors))
+
+    def arm(self, monitor: Monitor) -> int:
+        key = next(self._keys)
+        self.monitors[key] = monitor
+        self.armed.append((self.periods + 1, monitor.event.name, monitor.negated))
+        return key
+
+    def disarm(self, key: int) -> None:
+        self.monitors.pop(key, None)
 
 
 @dataclass(frozen=True)
@@ -73,38 +117,46 @@ class Behaviour:
     message: str = ""
 
 
-class _Motion(Primitive):
+_DEFAULT = Behaviour()
+
+
+class _Motion(Primitive[FakeSnapshot]):
     def __init__(self, robot: FakeRobot, info: RunInfo) -> None:
-        self.robot, self.info = robot, info
+        self.commands, self.effectors = robot.commands, info.event.effectors
+        self.stops = robot.stops
+        self.name = info.event.name
 
-    def start(self, snapshot: Any) -> None:
-        pass
-
-    def step(self, snapshot: Any, now: Now) -> Ended | None:
-        for effector in self.info.event.effectors:
-            self.robot.commands[effector] = now.progress
+    def step(self, snapshot: FakeSnapshot, now: Now) -> Ended | None:
+        for effector in self.effectors:
+            self.commands[effector] = now.progress
         return None
 
+    def stop(self) -> None:
+        self.stops.append(self.name)
 
-class _Wait(Primitive):
-    def __init__(self, info: RunInfo, behaviour: Behaviour, outcome: Outcome) -> None:
-        self.info, self.behaviour, self.outcome = info, behaviour, outcome
 
-    def start(self, snapshot: Any) -> None:
-        pass
+class _Wait(Primitive[FakeSnapshot]):
+    def __init__(
+        self, robot: FakeRobot, info: RunInfo, behaviour: Behaviour, outcome: Outcome
+    ) -> None:
+        self.behaviour, self.outcome = behaviour, outcome
+        self.stops, self.name = robot.stops, info.event.name
 
-    def step(self, snapshot: Any, now: Now) -> Ended | None:
+    def step(self, snapshot: FakeSnapshot, now: Now) -> Ended | None:
         duration = self.behaviour.duration
         if duration is not None and now.elapsed >= duration - 1e-9:
             return Ended(self.outcome, self.behaviour.message)
         return None
 
+    def stop(self) -> None:
+        self.stops.append(self.name)
 
-class _Sense(InstantPrimitive):
+
+class _Sense:
     def __init__(self, outcome: Outcome, message: str) -> None:
         self.outcome, self.message = outcome, message
 
-    def sense(self, snapshot: Any) -> Ended:
+    def sense(self, snapshot: FakeSnapshot) -> Ended:
         return Ended(self.outcome, self.message, {"periods": snapshot.periods})
 
 
@@ -120,16 +172,16 @@ class FakeFactory:
             self._calls[event] = itertools.chain(outs, itertools.repeat(outs[-1]))
         return next(self._calls[event])
 
-    def __call__(self, info: RunInfo) -> Primitive:
+    def __call__(self, info: RunInfo) -> Primitive[FakeSnapshot] | Sensor[FakeSnapshot]:
         name = info.event.name
-        behaviour = self.behaviours.get(name, Behaviour())
+        behaviour = self.behaviours.get(name, _DEFAULT)
         length = info.event.instruction.length
         if length == "fixed":
             return _Motion(self.robot, info)
         outcome = self._next(name, behaviour)
         if length == "zero" or info.instant:
             return _Sense(outcome, behaviour.message)
-        return _Wait(info, behaviour, outcome)
+        return _Wait(self.robot, info, behaviour, outcome)
 
 
 @dataclass
@@ -141,17 +193,23 @@ class FakeResult:
 
     def starts(self, event: str) -> list[tuple[int, float]]:
         """(tick, time) of each start of ``event``."""
-        return [(r["tick"], r["t"]) for r in self.log.of("start") if r["event"] == event]
+        return [_tick_t(r) for r in self.log.of("start") if r["event"] == event]
 
     def ends(self, event: str) -> list[tuple[int, float, str]]:
         """(tick, time, outcome) of each end of ``event``."""
-        return [
-            (r["tick"], r["t"], r["outcome"]) for r in self.log.of("end") if r["event"] == event
-        ]
+        return [(*_tick_t(r), str(r["outcome"])) for r in self.log.of("end") if r["event"] == event]
 
     def stretches(self) -> dict[int, int]:
         """Absolute tick -> periods it was stretched by, for stretched ticks."""
-        return {r["tick"]: r["stretch"] for r in self.log.of("tick") if r["stretch"]}
+        return {
+            int(str(r["tick"])): int(str(r["stretch"])) for r in self.log.of("tick") if r["stretch"]
+        }
+
+
+def _tick_t(record: Record) -> tuple[int, float]:
+    tick, t = record["tick"], record["t"]
+    assert isinstance(tick, int) and isinstance(t, float | int)
+    return tick, float(t)
 
 
 def run_fake(
@@ -161,15 +219,23 @@ def run_fake(
     period: float = 0.01,
     path: str = "fake.dial",
     fault_at: Mapping[int, str] | None = None,
+    holds: Mapping[str, Collection[int]] | None = None,
+    paced: bool = True,
 ) -> FakeResult:
-    """Check ``script`` (text or checked script) and run it on a fake robot, on virtual time."""
+    """Check ``script`` (text or checked script) and run it on a fake robot.
+
+    ``paced``: the runner keeps pace with trio's clock, a ``MockClock`` here, as
+    ``--realtime`` does with the wall clock; so trio's (virtual) time ends equal to the
+    simulated time. Unpaced, it runs as ``dial run`` does, as fast as it can.
+    """
     if isinstance(script, str):
-        checked = check_text(script, path, origin=Path(path))
+        checked = check_text(script, path)
         assert checked is not None
         script = checked
-    robot = FakeRobot(period, fault_at)
+    robot = FakeRobot(period, fault_at, holds)
     log = EventLog()
-    runner = Runner(robot, FakeFactory(robot, behaviours or {}), tick, log)
+    factory = FakeFactory(robot, behaviours or {})
+    runner = Runner(robot, factory, tick, log, pace=1.0 if paced else None)
     clock = trio.testing.MockClock(autojump_threshold=0)
     summary = trio.run(runner.run, script, clock=clock)
     return FakeResult(summary, log, robot, clock.current_time())

@@ -19,9 +19,11 @@ import trio
 import trio.testing
 
 from dial.instructions.types import EFFECTORS
-from dial.parser.check import Script, load
+from dial.parser.check import load
+from dial.parser.script import Script
 from dial.scheduler.log import EventLog
 from dial.scheduler.runner import Runner, RunSummary
+from dial.scheduler.types import Report
 from dial.testing.fake import FakeFactory, FakeRobot
 from dial.tune.grid import Trial
 from dial.tune.trial import RunReport
@@ -40,12 +42,12 @@ class LimitedRobot(FakeRobot):
         self.max_speed = max_speed
         self.positions: dict[str, float] = dict.fromkeys(EFFECTORS, 0.0)
 
-    async def advance(self) -> str | None:
+    def advance(self) -> Report | None:
         reach = self.max_speed * self.period
         for effector, command in self.commands.items():
             here = self.positions[effector]
             self.positions[effector] = here + min(reach, max(-reach, command - here))
-        return await super().advance()
+        return super().advance()
 
     def shortfall(self) -> float:
         """The largest distance between an effector and its command."""

@@ -56,7 +56,7 @@ def tune(
     """Run the sweep and report it: 0 if some tick length always succeeded, else 1."""
     out, err = out or sys.stdout, err or sys.stderr  # looked up now: tests replace them
     path = resolve_script(options.script)
-    load(path, load_scene_names, scene=options.scene)  # an error never starts a sweep
+    load(path, loader=load_scene_names, scene=options.scene)  # an error never starts a sweep
     trials = plan(
         str(path.resolve()),
         str(path),

@@ -52,7 +52,7 @@ def engine_backend(trial: Trial) -> RunReport:
     from dial.parser.check import load
     from dial.scene import load_scene_names
 
-    script = load(trial.script, load_scene_names, display=trial.display, scene=trial.scene)
+    script = load(trial.script, loader=load_scene_names, display=trial.display, scene=trial.scene)
     options = RunOptions(tick=trial.tick, seed=trial.seed, perturb_mm=trial.perturb_mm)
     result = run(script, options)
     summary = result.summary

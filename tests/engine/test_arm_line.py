@@ -10,8 +10,9 @@ import pytest
 
 from dial.backend.ik import ArmIK
 from dial.backend.model import ARM_HOME
-from dial.primitives.arm import LINE_STEP, Planner, slerp
-from dial.primitives.context import Context, rpy_matrix
+from dial.geometry import rpy_matrix, slerp
+from dial.primitives.arm import LINE_STEP, Planner
+from dial.primitives.context import Context
 
 
 @pytest.fixture(scope="module")

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 import dial.engine as engine
+import dial.engine.setup as setup
 from dial.backend.driver import MujocoRobot
 from dial.parser import load
 from dial.scene import load_scene_names
@@ -53,7 +54,7 @@ class RecordingRobot(MujocoRobot):
     def _check_guards(self) -> None:
         if not hasattr(self, "history"):
             self.history = []
-        depth = float(self.tactile()[0].max())
+        depth = float(self.snapshot().tactile[0].max())
         tip_z = float(self.data.site_xpos[self.index.fingertip_sites[0]][2])
         self.history.append((self.steps, depth, tip_z))
         super()._check_guards()
@@ -66,18 +67,18 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> tuple[engine.RunResult, Rec
     path = folder / "guarded.dial"
     path.write_text(SCRIPT.replace("\\\n", ""))
     robots: list[RecordingRobot] = []
-    original = engine.MujocoRobot
+    original = setup.MujocoRobot
 
     class Capture(RecordingRobot):
         def __init__(self, *args: object, **kwargs: object) -> None:
             super().__init__(*args, **kwargs)  # type: ignore[arg-type]
             robots.append(self)
 
-    engine.MujocoRobot = Capture  # type: ignore[misc]
+    setup.MujocoRobot = Capture  # type: ignore[misc]
     try:
-        result = engine.run(load(path, load_scene_names), engine.RunOptions())
+        result = engine.run(load(path, loader=load_scene_names), engine.RunOptions())
     finally:
-        engine.MujocoRobot = original  # type: ignore[misc]
+        setup.MujocoRobot = original  # type: ignore[misc]
     return result, robots[0]
 
 

@@ -18,7 +18,7 @@ from ..conftest import ROOT
 
 
 def test_lightbulb_comes_out_held_when_5mm_off() -> None:
-    script = load(ROOT / "scripts" / "lightbulb.dial", load_scene_names)
+    script = load(ROOT / "scripts" / "lightbulb.dial", loader=load_scene_names)
     result = run(script, RunOptions(perturb_mm=5.0, seed=4))
     assert result.summary.ok, result.summary.error
     assert result.success == {"bulb_out": True, "bulb_held": True}, result.details
@@ -30,7 +30,7 @@ def test_lightbulb_comes_out_held_when_5mm_off() -> None:
 
 @pytest.mark.parametrize("seed", [1, 6, 7])
 def test_lightbulb_centres_on_the_glass_by_touch_when_10mm_off(seed: int) -> None:
-    script = load(ROOT / "scripts" / "lightbulb.dial", load_scene_names)
+    script = load(ROOT / "scripts" / "lightbulb.dial", loader=load_scene_names)
     result = run(script, RunOptions(perturb_mm=10.0, seed=seed))
     assert result.summary.ok, result.summary.error
     assert result.success == {"bulb_out": True, "bulb_held": True}, result.details
@@ -46,7 +46,7 @@ def test_lightbulb_centres_on_the_glass_by_touch_when_10mm_off(seed: int) -> Non
 def test_at_a_fast_tick_the_thumb_feels_only_once_at_rest() -> None:
     # At 0.04 s the fingers still ring from the approach: without waiting for them to rest,
     # the force guard fired after 1-3 mm, before the glass.
-    script = load(ROOT / "scripts" / "lightbulb.dial", load_scene_names)
+    script = load(ROOT / "scripts" / "lightbulb.dial", loader=load_scene_names)
     result = run(script, RunOptions(tick=0.04))
     assert result.success == {"bulb_out": True, "bulb_held": True}, result.details
     waits = [r["value"] for r in result.log.of("condition") if r["condition"] == "ringing"]

@@ -6,7 +6,6 @@ from pathlib import Path
 
 import mujoco
 import pytest
-import trio
 
 from dial.backend.driver import MujocoRobot
 from dial.backend.model import load_model
@@ -23,9 +22,11 @@ def _robot() -> MujocoRobot:
 def test_a_diverging_state_is_a_fault(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.chdir(tmp_path)  # MuJoCo writes its warning to MUJOCO_LOG.TXT here
     robot = _robot()
-    assert trio.run(robot.advance) is None
+    assert robot.advance() is None
     robot.data.qvel[robot.index.hand_dof[0]] = 1e12  # beyond MuJoCo's bound: it resets
-    assert trio.run(robot.advance) == "the physics diverged (MuJoCo reset an unstable state)"
+    report = robot.advance()
+    assert report is not None
+    assert report.fault == "the physics diverged (MuJoCo reset an unstable state)"
 
 
 def test_an_arm_joint_past_its_limit_is_a_fault() -> None:
@@ -33,19 +34,22 @@ def test_an_arm_joint_past_its_limit_is_a_fault() -> None:
     j = robot.index.arm_qpos[1]
     robot.data.qpos[j] = robot.model.jnt_range[1, 1] + 0.2  # joint 2, far past its stop
     robot.arm_target = robot.data.qpos[robot.index.arm_qpos].copy()
-    fault = trio.run(robot.advance)
-    assert fault is not None and fault.startswith("PUMA joint 2 is beyond its limit")
+    report = robot.advance()
+    assert report is not None and report.fault is not None
+    assert report.fault.startswith("PUMA joint 2 is beyond its limit")
 
 
 def test_a_tendon_held_at_its_limit_is_logged_once_per_episode() -> None:
     robot = _robot()
     robot.arm_target = robot.data.qpos[robot.index.arm_qpos].copy()
-    robot._pinned_at = 5.0  # below the 10 N pretension: every tendon counts as pinned
+    robot.safety._pinned_at = 5.0  # below the 10 N pretension: every tendon counts as pinned
     for _ in range(99):  # 0.99 s: not yet held for a second
-        assert trio.run(robot.advance) is None
-    assert robot.log.of("warning") == []
+        assert robot.advance() is None
+    warnings = []
     for _ in range(100):  # a run never aborts for it
-        assert trio.run(robot.advance) is None
-    warnings = robot.log.of("warning")
+        report = robot.advance()
+        assert report is None or report.fault is None
+        warnings += [h for h in (report.happenings if report else ()) if h.kind == "warning"]
     assert len(warnings) == 32  # each tendon once, not once per period
-    assert "index joint 0 flexor tendon held at its 50 N limit for 1 s" in warnings[0]["message"]
+    message = warnings[0].fields["message"]
+    assert "index joint 0 flexor tendon held at its 50 N limit for 1 s" in str(message)

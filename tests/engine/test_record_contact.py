@@ -15,9 +15,8 @@ from typing import Any
 import numpy as np
 import pytest
 
-import dial.engine as engine
-from dial.parser import load
-from dial.scene import load_scene_names
+import dial
+from dial.engine import RunResult
 
 FACE_X, EDGE_Y = 0.49, -0.025  # m
 TOL = 0.001  # m: a contact point lies within half the penetration of the surface
@@ -56,29 +55,47 @@ SCRIPT = f"""\
 to_face   #=====--
 probe     #
 before     #
-in                #
-pad                #
-link               #
-back               #
-out                 #
-after                #
-free                 #
-to_edge               #==-
-in                        #
-edge_pad                   #
-edge_link                  #
+
+in        #
+
+pad       #
+link      #
+back      #
+out        #
+after       #
+free        #
+
+to_edge   #==-
+in            #
+
+edge_pad  #
+edge_link #
 """
 
 
 @pytest.fixture(scope="module")
-def ends(tmp_path_factory: pytest.TempPathFactory) -> dict[str, list[dict[str, Any]]]:
+def script(tmp_path_factory: pytest.TempPathFactory) -> Path:
     folder = Path(tmp_path_factory.mktemp("record"))
     (folder / "world.toml").write_text(WORLD)
     (folder / "record.dial").write_text(SCRIPT)
-    result = engine.run(load(folder / "record.dial", load_scene_names), engine.RunOptions())
+    return folder / "record.dial"
+
+
+@pytest.fixture(scope="module")
+def run(script: Path, tmp_path_factory: pytest.TempPathFactory) -> tuple[RunResult, Path]:
+    """The run, saving its state before block 5 (the first 'edge_pad'): between the guarded
+    move that stopped on the edge and the records of that stop."""
+    state = Path(tmp_path_factory.mktemp("state")) / "record.state"
+    result = dial.run(dial.load(script), save_at=(5, state))
     assert result.summary.error is None, result.summary.error
+    assert result.saved == ((5, state),)
+    return result, state
+
+
+@pytest.fixture(scope="module")
+def ends(run: tuple[RunResult, Path]) -> dict[str, list[dict[str, Any]]]:
     out: dict[str, list[dict[str, Any]]] = {}
-    for record in result.log.of("end"):
+    for record in run[0].log.of("end"):
         out.setdefault(record["event"], []).append(record)
     return out
 
@@ -124,3 +141,13 @@ def test_an_edge_outside_the_taxels_is_located_on_the_links(
     edge = _point(ends["edge_link"][0])
     assert edge[0] == pytest.approx(FACE_X, abs=TOL)
     assert edge[1] == pytest.approx(EDGE_Y, abs=TOL)
+
+
+def test_a_resumed_run_records_the_stop_it_saved(script: Path, run: tuple[RunResult, Path]) -> None:
+    """The stop contacts are part of a run's state: resumed between the stop and its records,
+    the run records the same points, bit for bit."""
+    full, state = run
+    resumed = dial.run(dial.load(script), resume=state)
+    points = [r["data"]["point"] for r in resumed.log.of("end") if r["event"] == "edge_link"]
+    assert points == [r["data"]["point"] for r in full.log.of("end") if r["event"] == "edge_link"]
+    assert resumed.final_qpos == full.final_qpos

@@ -63,26 +63,50 @@ def test_grasp_timeout_aborts_naming_event_line_and_tick(
     assert [r["kind"] for r in records[-2:]] == ["error", "summary"]
 
 
-def test_sigint_ends_the_run_with_130_and_a_complete_log(tmp_path: Path) -> None:
+def _running(tmp_path: Path) -> tuple[subprocess.Popen[bytes], Path]:
+    """A long `dial run --log` that has got going (five ticks logged)."""
     body = '% to puma_command "ex to_block"\n% back puma_command "ex retract_arm"\n'
     body += "@repeat 200\nto   #====\nback      #====\n@end\n"
     path = _script(tmp_path, body)
     log = tmp_path / "log.jsonl"
     env = {**os.environ, "PYTHONUNBUFFERED": "1"}
-    proc = subprocess.Popen([*DIAL, "run", str(path), "--log", str(log), "--quiet"], env=env)
+    proc = subprocess.Popen(
+        [*DIAL, "run", str(path), "--log", str(log), "--quiet"], env=env, stderr=subprocess.PIPE
+    )
     deadline = time.monotonic() + 60
     while time.monotonic() < deadline and proc.poll() is None:
         if log.exists() and log.read_text().count('"kind":"tick"') >= 5:
-            break
+            return proc, log
         time.sleep(0.05)
-    else:
-        proc.kill()
-        raise AssertionError("the run did not start")
-    proc.send_signal(signal.SIGINT)
+    proc.kill()
+    raise AssertionError("the run did not start")
+
+
+@pytest.mark.parametrize(
+    ("signals", "status", "name"),
+    [
+        ((signal.SIGINT,), 130, "SIGINT"),
+        ((signal.SIGTERM,), 143, "SIGTERM"),
+        ((signal.SIGINT, signal.SIGINT), 130, "SIGINT"),  # the second 50 ms later
+        ((signal.SIGTERM, signal.SIGINT), 143, "SIGTERM"),
+    ],
+)
+def test_signals_end_the_run_cleanly_with_a_complete_log(
+    tmp_path: Path, signals: tuple[int, ...], status: int, name: str
+) -> None:
+    proc, log = _running(tmp_path)
     sent = time.monotonic()
-    assert proc.wait(timeout=30) == 130
-    assert time.monotonic() - sent < 10  # generous: the machine is shared
+    for k, sig in enumerate(signals):
+        if k:
+            time.sleep(0.05)
+        proc.send_signal(sig)
+    assert proc.wait(timeout=60) == status
+    assert time.monotonic() - sent < 20  # generous: the machine is shared
+    assert proc.stderr is not None
+    err = proc.stderr.read().decode()
+    assert err == f"dial: interrupted by {name}; every effector holds its pose\n"
     records = [json.loads(line) for line in log.read_text().splitlines()]  # all complete
-    assert records[-1]["kind"] == "interrupted"
+    assert [r["kind"] for r in records[-2:]] == ["interrupted", "summary"]
+    assert records[-2]["signal"] == name and records[-1]["interrupted"] == name
     ticks = [r for r in records if r["kind"] == "tick"]
-    assert records[-1]["t"] <= ticks[-1]["t1"] + 0.5  # stopped within the tick it was in
+    assert records[-2]["t"] <= ticks[-1]["t1"] + 0.5  # stopped within the tick it was in

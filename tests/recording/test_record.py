@@ -12,11 +12,11 @@ from rerun.chunk import Chunk, RrdReader
 
 from dial.backend.model import FINGERS
 from dial.cli import main
-from dial.engine import RunOptions, run
+from dial.engine import RunOptions, StateLog, run
 from dial.parser import load
 from dial.recording.frames import RECORD_HZ, Batch
-from dial.recording.observers import Recorder, StateLog
-from dial.recording.rerun_sink import RerunSink
+from dial.recording.observers import Recorder
+from dial.recording.rerun_sink import GUARD_SHOWN_S, SOLID, RerunSink
 from dial.scene import load_scene_names
 from tests.recording.conftest import without_wall_time
 
@@ -33,7 +33,8 @@ def _rows(chunks: list[Chunk], path: str, column: str) -> list[Any]:
     """Every non-static value of ``column`` at ``path``, in time order."""
     rows: list[tuple[Any, Any]] = []
     for c in chunks:
-        if c.entity_path == path and not c.is_static:
+        has = column in c.to_record_batch().schema.names
+        if c.entity_path == path and not c.is_static and has:
             rows += zip(_column(c, "sim_time"), _column(c, column), strict=True)
     return [value for _, value in sorted(rows, key=lambda r: r[0])]
 
@@ -62,18 +63,22 @@ def test_record_holds_the_run_and_leaves_the_log_unchanged(
     assert len(reader.recordings()) == 1 and len(reader.blueprints()) == 1
     chunks = _chunks(rrd)
     paths = {c.entity_path for c in chunks}
-    expected = {"/world", "/world/surface_block", "/world/puma_link2", "/world/hand_index_distal"}
-    expected |= {f"/robot/{kind}/{f}" for kind in ("joints", "tendons") for f in FINGERS}
-    expected |= {f"/tactile/{f}" for f in FINGERS}
-    expected |= {"/events/log", "/events/lanes/to", "/events/lanes/grab", "/events/lanes/forces"}
+    expected = {"/world", "/world/block", "/world/arm/link2", "/world/hand/index_distal"}
+    expected |= {f"/robot/{kind}/{f}" for kind in ("hand", "tendons") for f in FINGERS}
+    expected |= {f"/tactile/{f}" for f in FINGERS} | {"/robot/arm", "/events/log"}
+    expected |= {"/01_to", "/02_open", "/03_grab", "/04_down", "/05_forces"}  # script order
     assert expected <= paths
 
-    # Geometry, once and static: the block is a box, finger links are capsules.
+    # Geometry, once and static, every shape solid: the block is a box, finger links capsules.
     def drawn(body: str, column: str) -> bool:
         return any(p.startswith(f"{body}/") and column in _static(chunks, p) for p in paths)
 
-    assert drawn("/world/surface_block", "Boxes3D:half_sizes")
-    assert drawn("/world/hand_index_distal", "Capsules3D:radii")
+    assert drawn("/world/block", "Boxes3D:half_sizes")
+    assert drawn("/world/hand/index_distal", "Capsules3D:radii")
+    assert "/world/hand/index_distal/capsule" in paths  # unnamed geoms are named by kind
+    for c in chunks:
+        if c.is_static and "Capsules3D:radii" in c.to_record_batch().schema.names:
+            assert _column(c, "Capsules3D:fill_mode") == [[SOLID.value]], c.entity_path
 
     # Both timelines, and only they, on everything that changes.
     for c in chunks:
@@ -82,40 +87,49 @@ def test_record_holds_the_run_and_leaves_the_log_unchanged(
 
     # Frames at RECORD_HZ of simulated time, from the start to the end of the run.
     sim_time = json.loads(plain.read_text().splitlines()[-1])["sim_time"]
-    joints = _rows(chunks, "/robot/joints/index", "Scalars:scalars")
+    joints = _rows(chunks, "/robot/hand/index", "Scalars:scalars")
     assert len(joints) == round(sim_time / 0.01) // round(100 / RECORD_HZ) + 1
     assert all(len(row) == 4 for row in joints)
     tendons = _rows(chunks, "/robot/tendons/thumb", "Scalars:scalars")
     assert len(tendons) == len(joints) and all(len(r) == 8 for r in tendons)
-    poses = _rows(chunks, "/world/hand_index_distal", "Transform3D:translation")
+    poses = _rows(chunks, "/world/hand/index_distal", "Transform3D:translation")
     assert len(poses) == len(joints)
     assert np.ptp(np.array(poses, dtype=float), axis=0).max() > 0.01  # the hand moved
 
-    # Tactile images: 16x16 float depths with a colormap.
+    arm = _rows(chunks, "/robot/arm", "Scalars:scalars")
+    assert len(arm) == len(joints) and all(len(row) == 6 for row in arm)
+
+    # Tactile images: 16x16 float depths (mm) with a colormap.
     for f in FINGERS:
         static = [c for c in chunks if c.entity_path == f"/tactile/{f}" and c.is_static]
-        (fmt,) = _column(static[0], "DepthImage:format")
+        (image,) = [c for c in static if "DepthImage:format" in c.to_record_batch().schema.names]
+        (fmt,) = _column(image, "DepthImage:format")
         assert isinstance(fmt, list) and (fmt[0]["width"], fmt[0]["height"]) == (16, 16)
         assert "DepthImage:colormap" in _static(chunks, f"/tactile/{f}")
         buffers = _rows(chunks, f"/tactile/{f}", "DepthImage:buffer")
         assert len(buffers) == len(joints)
         assert all(np.frombuffer(bytes(b[0]), np.float32).shape == (256,) for b in buffers)
 
-    # Event lanes: running from a start to the end.
-    lane = _rows(chunks, "/events/lanes/to", "StateChange:state")
-    assert lane[0] == ["running"] and lane[-1] in (None, [])
+    # Event lanes: running from a start, then the outcome over the same span, then held.
+    lane = _rows(chunks, "/02_open", "StateChange:state")
+    assert lane[:3] == [["running"], ["done"], ["held"]] and lane[-1] in ([], [""])  # ends it
     text = [t[0] for t in _rows(chunks, "/events/log", "TextLog:text")]
     assert "start to (line 9)" in text and any(t.startswith("end   grab done") for t in text)
     assert any(t.startswith(("OK", "FAILED")) for t in text)  # the criteria, at the end
 
 
 def test_observers_leave_the_physics_alone(short_script: Path, tmp_path: Path) -> None:
-    script = load(short_script, load_scene_names)
+    script = load(short_script, loader=load_scene_names)
     bare = run(script, RunOptions())
     sink = RerunSink(tmp_path / "run.rrd")
     watched = run(script, RunOptions(observers=[StateLog(), Recorder(sink, "short")]))
     assert watched.final_qpos == bare.final_qpos
-    assert [r for r in watched.log.records if r["kind"] != "state"] == bare.log.records
+
+    def timeless(records: list[dict[str, object]]) -> list[dict[str, object]]:
+        return [{k: v for k, v in r.items() if k != "wall_time"} for r in records]
+
+    records = [r for r in watched.log.records if r["kind"] != "state"]
+    assert timeless(records) == timeless(bare.log.records)
 
 
 def test_tactile_images_show_the_fingertip_up(tmp_path: Path) -> None:
@@ -128,15 +142,17 @@ def test_tactile_images_show_the_fingertip_up(tmp_path: Path) -> None:
         pos=np.zeros((n, 0, 3)),
         quat=np.zeros((n, 0, 4)),
         joints=np.zeros((n, 16)),
+        arm=np.zeros((n, 6)),
         tensions=np.zeros((n, 32)),
         tactile=tactile,
+        task=np.zeros((n, 0)),
     )
     sink = RerunSink(tmp_path / "tactile.rrd")
     sink.frames(batch)
     sink.close()
     (first, _) = _rows(_chunks(tmp_path / "tactile.rrd"), "/tactile/thumb", "DepthImage:buffer")
     image = np.frombuffer(bytes(first[0]), np.float32).reshape(16, 16)
-    assert image[0, 0] == np.float32(5e-4) and np.count_nonzero(image) == 1  # top left
+    assert image[0, 0] == np.float32(0.5) and np.count_nonzero(image) == 1  # top left, in mm
 
 
 def test_contact_points_and_fits_are_drawn(tmp_path: Path) -> None:
@@ -170,8 +186,14 @@ def test_contact_points_and_fits_are_drawn(tmp_path: Path) -> None:
         sink.record(record, 3, tips)
     sink.close()
     chunks = _chunks(tmp_path / "fits.rrd")
-    guards = _rows(chunks, "/world/contacts/guards", "Points3D:positions")
+    guards = _rows(chunks, "/world/contacts/guards/01", "Points3D:positions")
     assert np.allclose(guards, [[tips[2]]])  # the ring fingertip
+    label = _rows(chunks, "/world/contacts/guards/01", "Points3D:labels")
+    assert label == [["ring tactile 0.001 m"]]
+    cleared = [c for c in chunks if c.entity_path == "/world/contacts/guards/01"]
+    cleared = [c for c in cleared if "Clear:is_recursive" in c.to_record_batch().schema.names]
+    (when,) = _column(cleared[0], "sim_time")
+    assert when.total_seconds() == pytest.approx(0.25 + GUARD_SHOWN_S)  # then it is gone
     assert np.allclose(
         _rows(chunks, "/world/contacts/top", "Points3D:positions"), [[[0.5, 0, 0.45]]]
     )

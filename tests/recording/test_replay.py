@@ -9,17 +9,44 @@ import pytest
 from rerun.chunk import RrdReader
 
 from dial.cli import main
-from dial.recording.observers import STATE_HZ
+from dial.engine.observe import STATE_HZ
 from dial.recording.timeline import describe, timeline, when
 from tests.recording.conftest import without_wall_time
+
+
+def _rounded(value: object) -> object:
+    """Floats to 0.1 mm: a replay's scene comes from positions logged to that precision."""
+    if isinstance(value, float):
+        return round(value, 4) + 0.0
+    if isinstance(value, list):
+        return [_rounded(v) for v in value]
+    return value
+
+
+def _blueprint(rrd: Path) -> list[tuple[str, str]]:
+    """The layout in a recording: every blueprint entity and component, without their ids."""
+    reader = RrdReader(rrd)
+    (store,) = reader.blueprints()
+    rows = []
+    for c in reader.stream(store=store).collect().stream():
+        batch = c.to_record_batch()
+        for name, column in zip(batch.schema.names, batch.columns, strict=True):
+            ids = ("contents", "root_container", "active_tab")  # random ids of the containers
+            if not name.startswith(("Container", "View", "TimePanel", "Spatial", "Eye")):
+                continue
+            if any(i in name for i in ids):
+                continue
+            rows.append((name, json.dumps(_rounded(column.to_pylist()), default=str)))
+    return sorted(rows)
 
 
 def test_replay_prints_the_timeline_and_rebuilds_a_recording(
     short_script: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    log, rrd = tmp_path / "run.jsonl", tmp_path / "replay.rrd"
-    main(["run", str(short_script), "--log", str(log), "--log-states", "--quiet"])
+    log, rrd, live = tmp_path / "run.jsonl", tmp_path / "replay.rrd", tmp_path / "live.rrd"
+    main(["run", str(short_script), "--log", str(log), "--log-states", "--record", str(live)])
     records = [json.loads(line) for line in log.read_text().splitlines()]
+    assert records[1]["kind"] == "lanes"  # the script's lanes, for the replay
     states = [r for r in records if r["kind"] == "state"]
     summary = records[-1]
     periods = round(summary["sim_time"] / 0.01)
@@ -40,9 +67,23 @@ def test_replay_prints_the_timeline_and_rebuilds_a_recording(
 
     chunks = list(RrdReader(rrd).stream().collect().stream())
     paths = {c.entity_path for c in chunks}
-    assert {"/world/surface_block", "/tactile/thumb", "/events/lanes/grab"} <= paths
-    rows = sum(c.num_rows for c in chunks if c.entity_path == "/world/hand_base")
+    assert {"/world/block", "/tactile/thumb", "/03_grab", "/robot/arm"} <= paths
+    rows = sum(c.num_rows for c in chunks if c.entity_path == "/world/hand/base")
     assert rows == len(states)
+
+    # The same layout and the same lanes as the live recording, holds included.
+    live_chunks = list(RrdReader(live).stream().collect().stream())
+    assert _blueprint(rrd) == _blueprint(live)
+    assert {p for p in paths if p[1:3].isdigit()} == {
+        c.entity_path for c in live_chunks if c.entity_path[1:3].isdigit()
+    }
+    lane = [
+        state
+        for c in chunks
+        if c.entity_path == "/02_open" and "StateChange:state" in c.to_record_batch().schema.names
+        for state in c.to_record_batch().column("StateChange:state").to_pylist()
+    ]
+    assert ["held"] in lane
 
 
 def test_replay_without_states_says_how_to_get_them(

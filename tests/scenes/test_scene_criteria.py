@@ -27,7 +27,7 @@ def test_fraction_in_region_and_upright(object_world: ObjectWorld) -> None:
         "in_cup": False,
         "upright": True,
     }
-    assert measure(criteria[1], model, data, {}) == (False, "0/36 in pour_cup_inside (min 50%)")
+    assert measure(criteria[1], model, data, {}) == (False, "0/20 in pour_cup_inside (min 50%)")
     # Tip the pitcher 30 degrees about x.
     adr = model.joint("pour_pitcher").qposadr[0]
     data.qpos[adr + 3 : adr + 7] = (math.cos(math.radians(15)), math.sin(math.radians(15)), 0, 0)

@@ -7,10 +7,12 @@ import mujoco
 import numpy as np
 import pytest
 
+from dial.backend.model import load_model
 from dial.scene import bundled_scene_names, load_world, worlds_dir
 from dial.scene.evaluate import evaluate
 from dial.scene.thread import find_threads
 
+from ..conftest import ROOT
 from .conftest import MODEL_DIR, object_world_xml, warnings
 
 SCENES = ("pour", "lightbulb", "surface", "containment")
@@ -76,3 +78,13 @@ def test_object_worlds_use_the_robot_physics_options() -> None:
     objects = mujoco.MjModel.from_xml_string(object_world_xml("surface"))
     for field in ("timestep", "integrator", "cone", "impratio", "solver", "iterations"):
         assert getattr(objects.opt, field) == getattr(scene.opt, field), field
+
+
+def test_the_pour_scene_before_issue_16_still_loads() -> None:
+    """benchmarks/bench_engine.py compares the pour physics with this copy of the old scene."""
+    world = load_world(ROOT / "benchmarks" / "pour_before" / "pour_before.toml")
+    model = load_model(world.model_path)
+    balls = [b for b in range(model.nbody) if model.body(b).name.startswith("pour_ball_")]
+    assert len(balls) == 36
+    assert not model.opt.enableflags & mujoco.mjtEnableBit.mjENBL_SLEEP
+    assert set(world.programs) == set(load_world(worlds_dir() / "pour.toml").programs)

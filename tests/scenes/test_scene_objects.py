@@ -12,7 +12,7 @@ from dial.scene.thread import find_threads
 
 from .conftest import ObjectWorld, step, warnings
 
-BALLS = [f"pour_ball_{k:02d}" for k in range(36)]
+BALLS = [f"pour_ball_{k:02d}" for k in range(20)]
 PITCH = 0.004  # m per turn
 TURNS = 1.5
 
@@ -30,14 +30,45 @@ GRIP = '<body name="grip" mocap="true" pos="0.55 -0.12 0.35"/>'
 WELD = '<weld body1="grip" body2="pour_pitcher"/>'
 
 
+def _asleep(model: mujoco.MjModel, data: mujoco.MjData, bodies: list[str]) -> int:
+    trees = model.body_treeid[[model.body(b).id for b in bodies]]
+    return int((data.tree_asleep[trees] >= 0).sum())
+
+
+def test_balls_start_at_rest_and_sleep(object_world: ObjectWorld) -> None:
+    model, data = object_world("pour")
+    assert model.opt.enableflags & mujoco.mjtEnableBit.mjENBL_SLEEP
+    ids = [model.body(b).id for b in BALLS]
+    start = data.xpos[ids].copy()
+    assert _asleep(model, data, BALLS) == 0
+    step(model, data, 0.1)
+    # The written positions are the resting ones: the pile sleeps at once, where it was put.
+    pile = [*BALLS, "pour_pitcher", "pour_lid", "pour_cup"]
+    assert _asleep(model, data, pile) == len(pile)
+    assert np.abs(data.xpos[ids] - start).max() < 2e-4
+
+
 def test_balls_stay_in_the_pitcher_at_rest(object_world: ObjectWorld) -> None:
     model, data = object_world("pour")
     assert _in_site(model, data, BALLS, "pour_pitcher_inside") == len(BALLS)
     step(model, data, 2.0)
     assert _in_site(model, data, BALLS, "pour_pitcher_inside") == len(BALLS)
-    ids = [model.body(b).id for b in BALLS]
-    assert np.abs(data.cvel[ids, 3:]).max() < 0.01  # settled (frictionless balls may spin)
+    assert _asleep(model, data, BALLS) == len(BALLS)  # no ball spins on: damping stops it
     assert warnings(data) == 0
+
+
+def test_a_spinning_ball_wakes_the_pile_and_it_sleeps_again(object_world: ObjectWorld) -> None:
+    model, data = object_world("pour")
+    step(model, data, 0.2)
+    # Spin about the vertical: no contact of a ball resists it (frictionless neighbours, no
+    # torsional friction on the floor), so only the joint damping can stop it.
+    dof = model.jnt_dofadr[model.body("pour_ball_06").jntadr[0]]
+    data.qvel[dof + 5] = 20.0
+    step(model, data, 0.01)
+    assert _asleep(model, data, BALLS) == 0
+    step(model, data, 1.5)
+    assert _asleep(model, data, BALLS) == len(BALLS)
+    assert _in_site(model, data, BALLS, "pour_pitcher_inside") == len(BALLS)
 
 
 def test_balls_pour_out_when_the_pitcher_tilts_120_degrees(object_world: ObjectWorld) -> None:

@@ -35,6 +35,7 @@ SCENES = (
     "explore_rounded",
     "lightbulb",
     "pour",
+    "reactions",
     "surface",
 )
 PAPER_PROGRAMS = {
@@ -173,7 +174,10 @@ def _world(tmp_path: Path, body: str) -> Path:
             "poses.p.pinky: unknown key; valid keys: index, middle",
         ),
         ("[poses.p]\nindex = { knuckle = 3 }", "valid keys: abd, mcp, pip, dip"),
-        ("[poses.p]\nindex = [0, 0, 0, 200]", "poses.p.index.dip: 200 deg is beyond +-180"),
+        (
+            "[poses.p]\nindex = [0, 0, 0, 200]",
+            "poses.p.index.dip: 200 deg is beyond the dip joint's upper limit of 90 deg by 110 deg",
+        ),
         ("[poses.p]", "poses.p: a pose must set at least one joint"),
         (
             '[criteria.c]\nkind = "best"',

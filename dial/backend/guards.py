@@ -1,0 +1,123 @@
+"""Contact conditions the driver tests after every physics step: guards and monitors.
+
+A **guard** belongs to a guarded move: when it trips, the driver freezes the guarded
+effector at that physics step. A **monitor** belongs to a watched span (DESIGN 2.7): it
+freezes nothing; the runner preempts the block. Both read the same contact readings as a
+contact wait does (:func:`~dial.backend.contact.contact_reading`), so a guard, a monitor
+and a wait mean the same contact.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from dial.backend.contact import POSITION_LEVER
+from dial.backend.model import RobotIndex, tendon_differentials
+from dial.backend.snapshot import FloatArray, Trip
+
+
+@dataclass(frozen=True)
+class Guard:
+    """Holds when any condition holds on any of the ``sense`` fingers (``negated``: when none
+    does). ``effector`` is frozen when a guard trips; None for a monitor."""
+
+    effector: str | None
+    conditions: tuple[tuple[str, float], ...]
+    sense: tuple[int, ...]
+    baseline: FloatArray  # (16,) differentials when armed, for force conditions
+    negated: bool = False
+
+
+class Readings:
+    """What guards and monitors read at one physics step, computed only as far as they need
+    (this runs after every physics step while one is armed). The formulas are
+    :func:`~dial.backend.contact.contact_reading`'s; a dropped-out sensor reads 0. One per
+    robot: :meth:`at_step` starts each step afresh."""
+
+    __slots__ = ("_data", "_diff", "_dropped", "_index", "_q", "_tactile", "_target")
+
+    def __init__(self, data: mujoco.MjData, index: RobotIndex, tactile_adr: Sequence[int]) -> None:
+        self._data, self._index = data, index
+        # Views into sensordata stay valid for the data's life: slicing once saves a lot.
+        self._tactile = [data.sensordata[a : a + 256] for a in tactile_adr]
+        self._target: FloatArray = np.zeros(16)
+        self._dropped: frozenset[tuple[str, int]] = frozenset()
+        self._diff: FloatArray | None = None
+        self._q: FloatArray | None = None
+
+    def at_step(self, target: FloatArray, dropped: frozenset[tuple[str, int]]) -> Readings:
+        self._target, self._dropped = target, dropped
+        self._diff = self._q = None
+        return self
+
+    def value(self, kind: str, f: int, baseline: FloatArray) -> float:
+        """The reading of contact ``kind`` on finger ``f``: m (tactile, position) or N."""
+        if self._dropped and (kind, f) in self._dropped:
+            return 0.0
+        if kind == "tactile":
+            return float(self._tactile[f].max())
+        joints = slice(4 * f, 4 * f + 4)
+        if kind == "force":
+            if self._diff is None:
+                self._diff = tendon_differentials(self._data, self._index)
+            return float(np.abs(self._diff[joints] - baseline[joints]).max())
+        if self._q is None:
+            self._q = self._data.qpos[self._index.hand_qpos]
+        return float(np.linalg.norm(self._target[joints] - self._q[joints])) * POSITION_LEVER
+
+
+def first_trip(guard: Guard, r: Readings, time: float, step: int) -> Trip | None:
+    """The condition that holds, if the guard fires at this step.
+
+    A guard fires on the first (condition, finger) whose reading reaches its threshold, in
+    declaration then finger order. A negated one fires when none does, and reports the
+    first reading.
+    """
+    first: tuple[str, int, float] | None = None
+    for kind, threshold in guard.conditions:
+        for f in guard.sense:
+            value = r.value(kind, f, guard.baseline)
+            if value >= threshold:
+                return None if guard.negated else Trip(time, step, kind, f, value)
+            if first is None:
+                first = (kind, f, value)
+    if guard.negated and first is not None:
+        return Trip(time, step, *first)
+    return None
+
+
+class Guards:
+    """The armed guards and monitors, by key, in the order they were armed."""
+
+    def __init__(self) -> None:
+        self.armed: dict[int, Guard] = {}
+        self._next = 0
+
+    def __bool__(self) -> bool:
+        return bool(self.armed)
+
+    def arm(self, guard: Guard) -> int:
+        self._next += 1
+        self.armed[self._next] = guard
+        return self._next
+
+    def disarm(self, key: int) -> None:
+        self.armed.pop(key, None)
+
+    def clear(self) -> None:
+        self.armed.clear()
+
+    def check(self, readings: Readings, time: float, step: int) -> list[tuple[int, Guard, Trip]]:
+        """The guards that trip at this step (each is disarmed: it fires once)."""
+        tripped: list[tuple[int, Guard, Trip]] = []
+        for key, guard in self.armed.items():
+            trip = first_trip(guard, readings, time, step)
+            if trip is not None:
+                tripped.append((key, guard, trip))
+        for key, _, _ in tripped:
+            del self.armed[key]
+        return tripped

@@ -1,0 +1,82 @@
+"""Engine-owned safety monitors, checked every control period; the script cannot switch
+them off: a diverged (non-finite) physics state, arm joints beyond their limits, and
+tendons held at their tension limit (a warning, not a fault)."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import mujoco
+import numpy as np
+
+from dial.backend.model import RobotIndex
+from dial.instructions.types import FINGERS
+from dial.scheduler.types import Happening
+
+SATURATION_LIMIT_S = 1.0  # a tendon pinned at its tension limit this long is logged
+LIMIT_SLACK = 0.05  # rad: the servo may press a joint this far into its limit stop
+
+_DIVERGENCE = (
+    mujoco.mjtWarning.mjWARN_BADQACC,
+    mujoco.mjtWarning.mjWARN_BADQPOS,
+    mujoco.mjtWarning.mjWARN_BADQVEL,
+)
+
+
+class Safety:
+    """The safety monitors of one robot."""
+
+    def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, index: RobotIndex) -> None:
+        self.data, self.index = data, index
+        # Views of MuJoCo's warning counters, looked up once: they follow data.warning.
+        self._divergence = [data.warning[w] for w in _DIVERGENCE]
+        arm_range = model.jnt_range[model.actuator_trnid[index.arm_actuators, 0]]
+        self._arm_lo = arm_range[:, 0] - LIMIT_SLACK
+        self._arm_hi = arm_range[:, 1] + LIMIT_SLACK
+        self._pinned_at = index.tension_limit - 1e-6
+        # Views where the addresses run in order (a read through them copies nothing).
+        self._arm_q = _view(data.qpos, index.arm_qpos)
+        self._tensions = _view(data.sensordata, index.tension_sensors)
+        self.saturated_since = np.full(32, -1.0)
+        self.saturation_logged = np.zeros(32, dtype=bool)
+
+    def check(self, time: float, happened: list[Happening]) -> str | None:
+        """A fault message, or None; appends a ``warning`` for a tendon held at its limit."""
+        ix = self.index
+        # MuJoCo resets the state itself when it meets a bad qacc/qpos/qvel, and counts a
+        # warning: a nonzero count is the divergence (the state is no longer the run's).
+        for warning in self._divergence:
+            if warning.number:
+                return "the physics diverged (MuJoCo reset an unstable state)"
+        q = self._arm_q()
+        if (q < self._arm_lo).any() or (q > self._arm_hi).any():
+            j = int(np.flatnonzero((q < self._arm_lo) | (q > self._arm_hi))[0])
+            return f"PUMA joint {j + 1} is beyond its limit ({np.degrees(q[j]):.1f} deg)"
+        # A tendon pinned at its limit is not a fault (a fist pressed into the palm does it),
+        # but a researcher should know: log it once per episode.
+        pinned = self._tensions() >= self._pinned_at
+        if not pinned.any() and not self.saturation_logged.any():
+            self.saturated_since.fill(-1.0)
+            return None
+        self.saturated_since[~pinned] = -1.0
+        self.saturated_since[pinned & (self.saturated_since < 0)] = time
+        held = pinned & (time - self.saturated_since >= SATURATION_LIMIT_S)
+        for k in np.flatnonzero(held & ~self.saturation_logged):
+            joint = int(k) // 2
+            message = (
+                f"{FINGERS[joint // 4]} joint {joint % 4} "
+                f"{'flexor' if k % 2 == 0 else 'extensor'} tendon held at its "
+                f"{ix.tension_limit:g} N limit for {SATURATION_LIMIT_S:g} s"
+            )
+            happened.append(Happening("warning", {"t": time, "message": message}))
+        self.saturation_logged = held | (self.saturation_logged & pinned)
+        return None
+
+
+def _view(array: np.ndarray, index: np.ndarray) -> Callable[[], np.ndarray]:
+    """A reader of ``array[index]``: a view when ``index`` runs in order, else a copy."""
+    first = int(index[0])
+    if np.array_equal(index, np.arange(first, first + len(index))):
+        view = array[first : first + len(index)]
+        return lambda: view
+    return lambda: array[index]

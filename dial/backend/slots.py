@@ -1,0 +1,81 @@
+"""The command slots of one run: it may command, limp and guard only its own effectors."""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from typing import Protocol
+
+import numpy as np
+
+from dial.backend.snapshot import FloatArray
+from dial.errors import DialError
+from dial.instructions.types import FINGERS
+
+
+class EffectorError(DialError):
+    """A primitive wrote to an effector its run does not own (a bug, not a script error)."""
+
+
+class Commanded(Protocol):
+    """What slots write to: the robot's set-points, limp joints and guards."""
+
+    arm_target: FloatArray  # (6,) rad
+    hand_target: FloatArray  # (16,) rad, mask order
+    limp: np.ndarray  # (16,) bool
+
+    def measured_hand(self) -> FloatArray: ...
+
+    def arm_guard(
+        self, effector: str, conditions: Iterable[tuple[str, float]], sense: Iterable[int]
+    ) -> int: ...
+
+    def disarm(self, key: int) -> None: ...
+
+
+def _bits(mask: int) -> list[int]:
+    return [k for k in range(16) if mask >> k & 1]
+
+
+class Slots:
+    """The command slots a run owns: writing another effector's raises :class:`EffectorError`."""
+
+    def __init__(self, robot: Commanded, effectors: frozenset[str]) -> None:
+        self.robot, self.effectors = robot, effectors
+
+    def _own(self, effector: str) -> None:
+        if effector not in self.effectors:
+            raise EffectorError(f"run does not own the {effector}")
+
+    def _own_bits(self, mask: int) -> list[int]:
+        bits = _bits(mask)
+        for f in {k // 4 for k in bits}:
+            self._own(FINGERS[f])
+        return bits
+
+    def arm(self, q: FloatArray) -> None:
+        """Set the six arm joint set-points (rad)."""
+        self._own("arm")
+        self.robot.arm_target = np.array(q, dtype=np.float64)
+
+    def joints(self, mask: int, q16: FloatArray) -> None:
+        """Set the hand joints selected by ``mask`` (bit 4*f + j) from ``q16`` (16,) rad."""
+        bits = self._own_bits(mask)
+        self.robot.hand_target[bits] = np.asarray(q16)[bits]
+
+    def limp(self, mask: int, on: bool) -> None:
+        """Make the masked joints back-drivable, or stiff again where they went."""
+        bits = self._own_bits(mask)
+        self.robot.limp[bits] = on
+        if not on:  # the joints hold where they went
+            self.robot.hand_target[bits] = self.robot.measured_hand()[bits]
+
+    def guard(
+        self, effector: str, conditions: Iterable[tuple[str, float]], sense: Iterable[int]
+    ) -> int:
+        """Freeze ``effector`` at the physics step where a contact condition holds on a
+        ``sense`` finger; returns the guard's key (its trip shows in later snapshots)."""
+        self._own(effector)
+        return self.robot.arm_guard(effector, conditions, sense)
+
+    def unguard(self, key: int) -> None:
+        self.robot.disarm(key)

@@ -1,0 +1,75 @@
+"""The ``dial`` command line: a thin layer over the Python API (:mod:`dial.api`).
+
+Exit status: 0 success, 1 a script or run error (or a failed criterion), 2 a usage error,
+130 SIGINT and 143 SIGTERM.
+"""
+
+from __future__ import annotations
+
+import argparse
+import signal
+import sys
+from collections.abc import Sequence
+
+from dial import __version__
+from dial.cli import preview, replay, run, teach, text, tune
+from dial.errors import DialError, OptionError, ScriptError
+
+EPILOG = """\
+scripts resolve as a path if it exists, else as a bundled example by name
+(so 'dial show pour.dial' works from any directory).
+
+exit status: 0 ok, 1 script error (or, for fmt --check, a file that would change),
+2 usage error, 130 interrupted (SIGINT), 143 terminated (SIGTERM)."""
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="dial",
+        description="Run DIAL-style tick-based timeline scripts on a simulated "
+        "Utah/MIT hand on a PUMA 560.",
+        epilog=EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument("--version", action="version", version=f"dial {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+    run.add_parser(sub)
+    replay.add_parser(sub)
+    text.add_parsers(sub)
+    tune.add_parser(sub)
+    teach.add_parsers(sub)
+    preview.add_parser(sub)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the command line; ``argv`` None: this process's arguments, as the ``dial``
+    program (which then also ignores stop signals while Python shuts down)."""
+    status = _main(argv)
+    if argv is None:
+        # Everything is written and said; a second Ctrl-C must not turn the exit status
+        # into death by signal while the interpreter tears MuJoCo and trio down.
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            signal.signal(sig, signal.SIG_IGN)
+    return status
+
+
+def _main(argv: Sequence[str] | None) -> int:
+    args = build_parser().parse_args(argv)
+    try:
+        status: int = args.func(args)
+    except ScriptError as e:
+        print(e.render(), file=sys.stderr)
+        return 1
+    except OptionError as e:
+        print(f"dial: {e}", file=sys.stderr)
+        return 2
+    except DialError as e:
+        print(f"dial: {e}", file=sys.stderr)
+        return 1
+    except KeyboardInterrupt:  # outside a run (which turns signals into a clean stop)
+        print("dial: interrupted", file=sys.stderr)
+        return 130
+    except BrokenPipeError:
+        return 0
+    return status

@@ -1,0 +1,44 @@
+"""What the subcommands share: script loading, ``--scene``, and usage errors."""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+
+from dial.api import load
+from dial.errors import OptionError
+from dial.parser.script import Script
+
+UsageError = OptionError  # a usage problem: exit status 2
+
+
+def load_script(arg: str, scene: str | None) -> Script:
+    """A script argument (a path, else a bundled name), checked against ``--scene``."""
+    return load(arg, scene=scene)
+
+
+def scene_argument(p: argparse.ArgumentParser, checking: bool = False) -> None:
+    what = "check names against" if checking else "run in"
+    p.add_argument(
+        "--scene",
+        metavar="NAME_OR_PATH",
+        help=f"{what} this scene instead of the script's @scene (so do the scripts it "
+        "@calls): a world file path, else a bundled scene name",
+    )
+
+
+def at_least(flag: str, value: int | None, least: int) -> None:
+    if value is not None and value < least:
+        raise UsageError(f"{flag} must be at least {least}, got {value}")
+
+
+def plot_usage(flag: str) -> None:
+    """A usage error (exit 2) if ``flag`` cannot draw here; offscreen EGL on headless Linux."""
+    if sys.platform.startswith("linux"):  # must precede `import mujoco`
+        os.environ.setdefault("MUJOCO_GL", "egl")
+    from dial.teach.pictures import plot_problem
+
+    problem = plot_problem(flag)
+    if problem is not None:
+        raise UsageError(problem)

@@ -1,0 +1,222 @@
+"""``dial run``: a thin layer over :func:`dial.run` that shows progress and a summary."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from collections.abc import Callable
+from typing import TYPE_CHECKING
+
+from dial import api
+from dial.cli.common import UsageError, load_script, scene_argument
+from dial.recording.timeline import qualified_event
+from dial.scheduler.signals import EXIT_STATUS, StopRequest, catch_stop_signals
+
+if TYPE_CHECKING:
+    from dial.engine import RunResult
+
+DESCRIPTION = (
+    "Run a script on the simulated hand and arm. Shows live progress, then each event's "
+    "outcome, the simulated and wall time and the scene's success criteria. Exit 0 when "
+    "the run completes and every criterion holds; 1 on a script or run error or a failed "
+    "criterion; 2 on a usage error; 130 on SIGINT (Ctrl-C) and 143 on SIGTERM, after every "
+    "effector holds and the log ends with 'interrupted' and 'summary'."
+)
+
+
+def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
+    p = sub.add_parser(
+        "run",
+        help="run a script in its scene and report the success criteria",
+        description=DESCRIPTION,
+    )
+    p.add_argument("script", metavar="SCRIPT", help="script path or bundled name")
+    scene_argument(p)
+    p.add_argument(
+        "--tick", type=float, metavar="S", help="tick length in s, 0 < S <= 60 (default: @tick)"
+    )
+    p.add_argument("--speed", type=float, default=1.0, metavar="F", help="divide the tick by F")
+    p.add_argument("--seed", type=int, default=0, metavar="N", help="seed for --perturb (>= 0)")
+    p.add_argument(
+        "--perturb",
+        type=float,
+        default=0.0,
+        metavar="MM",
+        help="displace the true object poses by MM (>= 0) from the believed ones, in a "
+        "direction drawn from --seed",
+    )
+    p.add_argument(
+        "--disturb",
+        action="append",
+        default=[],
+        metavar="SPEC",
+        help="a deliberate fault, repeatable: 'push body=NAME force=FX,FY,FZ at=T for=D' "
+        "(a world-frame force in N from T s for D s) or 'sense sensor=KIND:FINGER at=T "
+        "[for=D]' (tactile, force or position reads as untouched); see docs/language.md",
+    )
+    p.add_argument("--log", metavar="FILE.jsonl", help="write the event log as JSON Lines")
+    p.add_argument("--json", action="store_true", help="print a JSON summary as the last line")
+    p.add_argument("--quiet", action="store_true", help="no progress and no summary table")
+    p.add_argument("--realtime", action="store_true", help="pace the run to wall-clock time")
+    p.add_argument(
+        "--log-states",
+        action="store_true",
+        help="also log the robot's and objects' state 25 times per simulated second, "
+        "for 'dial replay --record'",
+    )
+    p.add_argument(
+        "--record",
+        metavar="FILE.rrd",
+        help="write a rerun recording: geometry, body poses, joints, tendons, tactile "
+        "images, event lanes (open with 'rerun FILE.rrd'; see docs/recording.md)",
+    )
+    p.add_argument(
+        "--video",
+        metavar="FILE.mp4",
+        help="render the run offscreen to an .mp4 or .gif at 25 frames per simulated "
+        "second (needs the 'video' extra)",
+    )
+    p.add_argument(
+        "--rerun", action="store_true", help="stream the recording to a spawned rerun viewer"
+    )
+    p.add_argument("--viewer", action="store_true", help="watch in MuJoCo's viewer, in real time")
+    debug = p.add_argument_group(
+        "debugging (docs/debugging.md)",
+        "A paused run reads commands from the terminal, or line by line from stdin when it is "
+        "not one: continue, tick, period, state, save FILE, quit, help.",
+    )
+    debug.add_argument(
+        "--break",
+        dest="breaks",
+        action="append",
+        default=[],
+        metavar="EVENT|tick:N|monitor",
+        help="pause before a run of EVENT starts, at the start of absolute tick N, or after a "
+        "monitor fires; repeatable",
+    )
+    debug.add_argument("--step", action="store_true", help="pause at the start of every tick")
+    debug.add_argument(
+        "--save-at",
+        nargs=2,
+        metavar=("block:N", "FILE"),
+        help="write a state file just before the N-th block the run starts (a repeated block "
+        "counts each time; 'dial show' numbers the blocks)",
+    )
+    debug.add_argument(
+        "--resume",
+        metavar="FILE",
+        help="go on from a state file (with its tick, seed, perturbation and disturbances); "
+        "lines of the script before the saved block must be unchanged",
+    )
+    p.set_defaults(func=cmd_run)
+
+
+def cmd_run(args: argparse.Namespace) -> int:
+    # From here to the exit, a stop signal stops the run (which catches it first) or, once
+    # the run is over, is ignored: a second Ctrl-C cannot cut the summary or the log short.
+    stop = StopRequest()
+    with catch_stop_signals(stop):
+        return _run(args, stop)
+
+
+def _run(args: argparse.Namespace, stop: StopRequest) -> int:
+    if args.log_states and not args.log:
+        raise UsageError("--log-states writes into the log: give --log FILE.jsonl too")
+    api.check_options(args.tick, args.speed, args.seed, args.perturb)
+    save_at = _save_at(args.save_at)
+    script = load_script(args.script, args.scene)
+    if stop.signal is not None:  # while the script was being checked
+        print(f"dial: interrupted by {stop.signal}", file=sys.stderr)
+        return EXIT_STATUS[stop.signal]
+    result = api.run(
+        script,
+        tick=args.tick,
+        speed=args.speed,
+        seed=args.seed,
+        perturb=args.perturb,
+        disturb=args.disturb,
+        log=args.log,
+        log_states=args.log_states,
+        record=args.record,
+        video=args.video,
+        rerun=args.rerun,
+        viewer=args.viewer,
+        realtime=args.realtime,
+        progress=_progress(args.quiet),
+        breaks=args.breaks,
+        step=args.step,
+        save_at=save_at,
+        resume=args.resume,
+    )
+    for number, target in result.saved:
+        print(f"dial: saved the state before block {number} to {target}", file=sys.stderr)
+    if not args.quiet and sys.stderr.isatty():
+        sys.stderr.write("\r" + " " * 100 + "\r")
+    if not args.quiet:
+        sys.stdout.write(summary_text(result))
+    stopped = result.summary.interrupted
+    if stopped is not None:
+        print(f"dial: interrupted by {stopped}; every effector holds its pose", file=sys.stderr)
+    elif result.error is not None:
+        print(f"dial: {result.error}", file=sys.stderr)
+    if args.json:
+        print(json.dumps(result.as_record()))
+    if stopped is not None:
+        return EXIT_STATUS.get(stopped, 130)
+    if save_at is not None and not result.saved:
+        print(
+            f"dial: --save-at block:{save_at[0]}: the run started fewer blocks; nothing was saved",
+            file=sys.stderr,
+        )
+        return 1
+    return 0 if result.ok else 1
+
+
+def _save_at(value: list[str] | None) -> tuple[int, str] | None:
+    """``--save-at block:N FILE`` as (N, FILE)."""
+    if value is None:
+        return None
+    where, target = value
+    digits = where.removeprefix("block:")
+    number = digits.isascii() and digits.isdigit() and len(digits) <= 9 and int(digits)
+    if not where.startswith("block:") or not number:
+        raise UsageError(f"--save-at: expected block:N FILE, N a block from 1; got '{where}'")
+    return number, target
+
+
+def _progress(quiet: bool) -> Callable[[int, float, list[str]], None] | None:
+    if quiet or not sys.stderr.isatty():
+        return None
+
+    def show(tick: int, sim_time: float, running: list[str]) -> None:
+        line = f"tick {tick:4d}  t={sim_time:7.2f} s  {', '.join(running) or '-'}"
+        sys.stderr.write("\r" + line[:100].ljust(100))
+        sys.stderr.flush()
+
+    return show
+
+
+def summary_text(result: RunResult) -> str:
+    """The table ``dial run`` prints: each run's end, the times, the criteria (pure)."""
+    s = result.summary
+    lines = [f"scene {result.world.name}: {s.ticks} ticks of {s.tick_length:g} s"]
+    ends = result.log.of("end")
+    names = [qualified_event(r) for r in ends]
+    width = max([len(n) for n in names] + [5])
+    for r, name in zip(ends, names, strict=True):
+        note = f"  {r['message']}" if r.get("message") else ""
+        lines.append(f"  tick {r['tick']:4d}  {name:<{width}}  {r['outcome']}{note}")
+    for r in result.log.of("monitor"):
+        lines.append(
+            f"  tick {r['tick']:4d}  monitor '@on {r['condition']}' fired at "
+            f"t={r['t']:.3f} s (line {r['line']})"
+        )
+    lines.append(
+        f"simulated {s.sim_time:.2f} s in {result.wall_time:.2f} s wall "
+        f"(real-time factor {result.real_time_factor:.1f}), {result.physics_steps} physics steps"
+    )
+    for name, ok in result.success.items():
+        lines.append(f"  [{'x' if ok else ' '}] {name}: {result.details[name]}")
+    lines.append("OK" if result.ok else "FAILED")
+    return "\n".join(lines) + "\n"

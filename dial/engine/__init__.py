@@ -1,0 +1,17 @@
+"""The engine: a checked script run in its scene, on the MuJoCo robot."""
+
+from dial.engine.observe import Observer, StateLog, Watched
+from dial.engine.result import Criteria, RunResult
+from dial.engine.run import DEFAULT_TICK, RunOptions, run, tick_length
+
+__all__ = [
+    "DEFAULT_TICK",
+    "Criteria",
+    "Observer",
+    "RunOptions",
+    "RunResult",
+    "StateLog",
+    "Watched",
+    "run",
+    "tick_length",
+]

@@ -1,0 +1,195 @@
+"""Run a checked script in its scene: set up, run the timeline, measure, summarise.
+
+This is the one place that joins the layers: the parser's script, the scheduler's runner,
+the primitives and the MuJoCo backend. The engine writes the ``scene``, ``state`` and
+``summary`` records; the runner writes the rest.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TextIO
+
+import trio
+
+from dial.backend.driver import MujocoRobot
+from dial.backend.snapshot import Snapshot
+from dial.debug import Break, Console, Session
+from dial.disturb import Disturbance, parse_disturbance
+from dial.engine.debugging import session
+from dial.engine.observe import Observer, StateLog, Watched, describe, fan_out, first_line
+from dial.engine.result import RunResult, measure_criteria
+from dial.engine.setup import prepare
+from dial.engine.state import RunSettings, Saved
+from dial.errors import DialError
+from dial.parser.lanes import LanePlan
+from dial.parser.script import Script
+from dial.primitives import Context, make_factory
+from dial.scheduler.log import EventLog
+from dial.scheduler.position import Resume
+from dial.scheduler.runner import Runner
+from dial.scheduler.signals import StopRequest, catch_stop_signals
+from dial.scheduler.ticks import Progress
+
+DEFAULT_TICK = 0.25  # s, when neither the script (@tick) nor the command line sets one
+MAX_TICK = 60.0  # s, as @tick's range
+
+
+@dataclass
+class RunOptions:
+    """How to run a script; the fields of ``dial run``'s options (see ``dial run --help``)."""
+
+    tick: float | None = None  # s; default: the script's @tick, else DEFAULT_TICK
+    speed: float = 1.0  # divides the tick
+    seed: int = 0
+    perturb_mm: float = 0.0
+    disturb: Sequence[Disturbance] = ()
+    realtime: bool = False
+    log: TextIO | None = None  # the JSON Lines sink, written and flushed record by record
+    log_states: bool = False
+    progress: Progress | None = None
+    observers: list[Observer] = field(default_factory=list)
+    # Debugging (DESIGN 6.1): where to pause, where commands come from, what to save.
+    breaks: Sequence[Break] = ()
+    step: bool = False
+    console: Console | None = None
+    save_at: tuple[int, Path] | None = None  # (block number, state file)
+    resume: Saved | None = None  # a state file to go on from (its settings win)
+
+
+def tick_length(script: Script, options: RunOptions) -> float:
+    """The tick the run uses, in s: ``--tick``, else ``@tick``, else the default; / speed."""
+    tick = options.tick if options.tick is not None else (script.tick or DEFAULT_TICK)
+    if not (math.isfinite(options.speed) and options.speed > 0):
+        raise DialError(f"--speed must be a positive number, got {options.speed:g}")
+    if not (math.isfinite(tick) and 0 < tick / options.speed <= MAX_TICK):
+        raise DialError(
+            f"the tick must be above 0 s and at most {MAX_TICK:g} s, got {tick / options.speed:g}"
+        )
+    return tick / options.speed
+
+
+def run(script: Script, options: RunOptions) -> RunResult:
+    """Run ``script`` to its end (or its abort, or a stop signal) and measure the criteria.
+
+    SIGINT and SIGTERM stop the run at the next control period, from the scene's loading on:
+    every effector holds, and the log ends with ``interrupted`` and ``summary``.
+    """
+    stop = StopRequest()
+    with catch_stop_signals(stop):
+        log = EventLog(options.log)
+        settings = _settings(script, options)
+        disturb = [parse_disturbance(d) for d in settings.disturb]
+        robot, ctx = prepare(script, log, settings.perturb_mm, settings.seed, disturb)
+        resume = _resume(script, options.resume, robot, ctx, log)
+        states = [StateLog(lanes=LanePlan.from_script(script))] if options.log_states else []
+        begun: list[Observer] = []
+        result: RunResult | None = None
+        try:  # observers end also on an error: a recording keeps what was seen
+            for observer in states + list(options.observers):
+                observer.begin(Watched(robot, ctx.world, log))
+                begun.append(observer)
+            runner = Runner(
+                robot,
+                make_factory(ctx),
+                settings.tick,
+                log,
+                progress=options.progress,
+                observe=fan_out(begun),
+                pace=1.0 if options.realtime else None,
+                stop=stop,
+            )
+            hooks = runner.hooks = _debugging(script, runner, ctx, stop, settings, begun, options)
+            start, cpu = time.perf_counter(), time.process_time()
+            summary = trio.run(runner.run, script, resume)
+            wall, cpu = time.perf_counter() - start, time.process_time() - cpu
+            result = RunResult(
+                summary,
+                ctx.world,
+                measure_criteria(ctx.world, robot.model, robot.data, ctx.results),
+                dict(ctx.results),
+                wall,
+                cpu,
+                robot.steps,
+                log,
+                [float(x) for x in robot.data.qpos],
+                settings.disturb,
+                tuple(hooks.saved) if hooks is not None else (),
+            )
+            log.write("summary", **result.as_record())
+            return result
+        finally:
+            _end(begun, result)
+
+
+def _resume(
+    script: Script, saved: Saved | None, robot: MujocoRobot, ctx: Context, log: EventLog
+) -> Resume | None:
+    """Put a saved state back (checking the script against it) and log the ``resume``."""
+    if saved is None:
+        return None
+    resume = saved.check(script)
+    saved.restore(robot, ctx)
+    log.write(
+        "resume",
+        file=str(saved.source),
+        block=resume.blocks + 1,
+        tick=resume.tick,
+        t=resume.periods * robot.period,
+    )
+    return resume
+
+
+def _settings(script: Script, options: RunOptions) -> RunSettings:
+    """The tick, seed, perturbation and disturbances: a resumed run takes its state file's."""
+    if options.resume is not None:
+        return options.resume.settings
+    return RunSettings(
+        tick_length(script, options),
+        options.seed,
+        options.perturb_mm,
+        tuple(d.text for d in options.disturb),
+    )
+
+
+def _debugging(
+    script: Script,
+    runner: Runner[Snapshot],
+    ctx: Context,
+    stop: StopRequest,
+    settings: RunSettings,
+    observers: list[Observer],
+    options: RunOptions,
+) -> Session | None:
+    """The session's hooks, if the run pauses or saves; None keeps the runner's hot path lean."""
+    if not (options.breaks or options.step or options.save_at):
+        return None
+    return session(
+        script,
+        runner,
+        ctx,
+        stop,
+        settings,
+        observers,
+        options.console,
+        options.breaks,
+        options.step,
+        options.save_at,
+    )
+
+
+def _end(observers: list[Observer], result: RunResult | None) -> None:
+    """End every observer, whatever the others do; then say which failed (the log and the
+    summary are written by then)."""
+    failed = []
+    for observer in observers:
+        try:
+            observer.end(result)
+        except Exception as e:
+            failed.append(f"{describe(observer)} failed: {first_line(e)}")
+    if failed:
+        raise DialError("; ".join(failed))

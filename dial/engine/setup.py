@@ -1,0 +1,117 @@
+"""Setting a run up: the scene's world and model, the robot at home, the perturbation.
+
+The world model is recorded as the **believed** object poses before ``--perturb`` moves
+the true ones, so that only sensing can make up the difference (DESIGN 5).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+
+import mujoco
+import numpy as np
+
+from dial.backend.disturb import Disturbances
+from dial.backend.driver import MujocoRobot
+from dial.backend.ik import ArmIK
+from dial.backend.model import ARM_HOME, RobotIndex, hand_ctrl, load_model
+from dial.disturb import Disturbance
+from dial.errors import DialError
+from dial.geometry import Pose, location_pose, rpy_matrix
+from dial.parser.script import Script
+from dial.primitives import Context
+from dial.scene.resolve import resolve_scene, worlds_dir
+from dial.scene.world import World, load_world
+from dial.scheduler.log import EventLog
+
+SETTLE_S = 0.5  # objects settle on the table before the script starts
+# Where the tool starts when the world file has no "home" location: high above the tables,
+# pointing down (world m; rpy as in world files).
+START = ((0.40, 0.0, 0.80), (np.pi, 0.0, 0.0))
+
+
+def script_world(script: Script) -> World:
+    """The world the script runs in: ``--scene``, else its ``@scene``."""
+    scene = script.program.scene
+    text = script.scene_override or (scene.text if scene is not None else None)
+    if text is None:
+        raise DialError(
+            f"{script.path}: the script names no scene; add '@scene NAME' or run it with --scene"
+        )
+    return load_world(resolve_scene(text, Path(script.path).resolve().parent))
+
+
+def scene_bodies(model: mujoco.MjModel, world: World) -> list[int]:
+    """Bodies a perturbation moves: every free body, and the world file's fixed objects."""
+    named = {
+        int(mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, b)) for b in world.objects.values()
+    }
+    free = {
+        int(model.jnt_bodyid[j])
+        for j in range(model.njnt)
+        if model.jnt_type[j] == mujoco.mjtJoint.mjJNT_FREE
+    }
+    return sorted(named | free)
+
+
+def perturb(model: mujoco.MjModel, world: World, mm: float, seed: int) -> list[float]:
+    """Shift the scene's objects by ``mm`` in a seeded horizontal direction; the shift in m.
+
+    It moves the model (a free body's initial position, a fixed object's position), before
+    any ``MjData`` is made from it: with sleeping on, MuJoCo places a fixed body only once,
+    when the data is made.
+    """
+    if mm <= 0:
+        return [0.0, 0.0, 0.0]
+    angle = np.random.default_rng(seed).uniform(0.0, 2.0 * np.pi)
+    shift = np.array([np.cos(angle), np.sin(angle), 0.0]) * mm / 1000.0
+    for body in scene_bodies(model, world):
+        joint = int(model.body_jntadr[body])
+        if joint >= 0 and model.jnt_type[joint] == mujoco.mjtJoint.mjJNT_FREE:
+            adr = int(model.jnt_qposadr[joint])
+            model.qpos0[adr : adr + 3] += shift
+        elif model.body_parentid[body] == 0 and model.body_jntnum[body] == 0:
+            model.body_pos[body] += shift
+    return [float(x) for x in shift]
+
+
+def prepare(
+    script: Script,
+    log: EventLog,
+    perturb_mm: float = 0.0,
+    seed: int = 0,
+    disturbances: Sequence[Disturbance] = (),
+) -> tuple[MujocoRobot, Context]:
+    """Load the scene, place the robot at home, perturb, settle; log the ``scene`` record."""
+    world = script_world(script)
+    model = load_model(world.model_path)
+    placed = Disturbances.on(model, disturbances)  # an unknown body fails before anything moves
+    index = RobotIndex.from_model(model)
+    unmoved = mujoco.MjData(model)
+    mujoco.mj_forward(model, unmoved)
+    believed: dict[str, Pose] = {
+        model.body(b).name: (unmoved.xpos[b].copy(), unmoved.xmat[b].reshape(3, 3).copy())
+        for b in scene_bodies(model, world)
+    }
+    shift = perturb(model, world, perturb_mm, seed)
+    data = mujoco.MjData(model)
+    ik = ArmIK()
+    if "home" in world.locations:
+        pos, rot = location_pose(world, believed, "home")
+    else:
+        pos, rot = np.array(START[0]), rpy_matrix(START[1])
+    home = ik.solve(pos, rot, np.array(ARM_HOME), "the start pose (location 'home')")
+    data.qpos[index.arm_qpos] = home
+    data.ctrl[index.arm_actuators] = home
+    data.ctrl[index.tendon_actuators] = hand_ctrl(data.qpos[index.hand_qpos])
+    mujoco.mj_forward(model, data)
+    for _ in range(round(SETTLE_S / model.opt.timestep)):
+        mujoco.mj_step(model, data)
+    # A bundled world by its file name; another by its absolute path, so that dial replay
+    # finds it from anywhere.
+    bundled = world.path.parent == worlds_dir().resolve()
+    where = world.path.name if bundled else str(world.path)
+    log.write("scene", scene=world.name, world=where, perturb=shift, seed=seed)
+    robot = MujocoRobot(model, data, disturbances=placed)
+    return robot, Context(robot, world, believed, ik)

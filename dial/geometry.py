@@ -1,0 +1,68 @@
+"""Rotations, time scalings and named locations: the geometry every layer shares.
+
+Pure numpy. Rotations are (3, 3) matrices; rpy angles are fixed-axis roll, pitch, yaw in
+rad, as in world files.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import numpy as np
+from numpy.typing import NDArray
+
+from dial.scene.world import World
+
+FloatArray = NDArray[np.float64]
+
+Pose = tuple[FloatArray, FloatArray]  # position (3,) m, rotation (3, 3)
+
+
+def rpy_matrix(rpy: tuple[float, float, float]) -> FloatArray:
+    """R = Rz(yaw) Ry(pitch) Rx(roll), fixed axes."""
+    (cr, sr), (cp, sp), (cy, sy) = ((np.cos(a), np.sin(a)) for a in rpy)
+    return np.array(
+        [
+            [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+            [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+            [-sp, cp * sr, cp * cr],
+        ]
+    )
+
+
+def smooth(u: float) -> float:
+    """Minimum-jerk time scaling of a segment: zero velocity and acceleration at both ends."""
+    u = min(1.0, max(0.0, u))
+    return u * u * u * (10.0 - 15.0 * u + 6.0 * u * u)
+
+
+def slerp(r0: FloatArray, r1: FloatArray, u: float) -> FloatArray:
+    """Rotation between ``r0`` and ``r1`` (u in [0, 1]) about their relative axis."""
+    rel = r0.T @ r1
+    angle = float(np.arccos(np.clip((np.trace(rel) - 1.0) / 2.0, -1.0, 1.0)))
+    if angle < 1e-9:
+        return r0.copy()
+    axis = np.array([rel[2, 1] - rel[1, 2], rel[0, 2] - rel[2, 0], rel[1, 0] - rel[0, 1]])
+    norm = np.linalg.norm(axis)
+    # A half turn has no antisymmetric part: its axis is the top eigenvector of rel + rel^T.
+    axis = np.linalg.eigh(rel + rel.T)[1][:, -1] if norm < 1e-9 else axis / norm
+    k = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+    a = angle * u
+    step = np.eye(3) + np.sin(a) * k + (1.0 - np.cos(a)) * (k @ k)
+    out: FloatArray = r0 @ step
+    return out
+
+
+def location_pose(world: World, believed: Mapping[str, Pose], name: str) -> Pose:
+    """A named location's tool pose in the world: position (3,), rotation (3, 3).
+
+    An object-relative location follows the object's *believed* pose.
+    """
+    loc = world.locations[name]
+    pos, rot = np.array(loc.pos, dtype=np.float64), rpy_matrix(loc.rpy)
+    if loc.body is None:
+        return pos, rot
+    body_pos, body_rot = believed[loc.body]
+    if loc.axes == "world":
+        return body_pos + pos, rot
+    return body_pos + body_rot @ pos, body_rot @ rot

@@ -1,0 +1,188 @@
+"""What the preview does with each instruction whose end the run cannot know in advance.
+
+Fixed-length instructions run through their own primitives (:mod:`dial.primitives`), the
+set-points going straight to the pose. The others are previewed at their start, at once:
+
+- ``guarded_move`` travels its line in small steps until the moving arm (the hand) or
+  finger first touches the world or an object other than what the hand holds, then stops
+  there (outcome ``done``), or travels its full ``max`` (``missed``). No ``press``.
+- ``grasp_force`` closes its joints until each finger touches something or reaches its
+  limit; the free bodies the fingers touch are held from then on (``done`` when every
+  tendon-watched finger touched something).
+- sensing and the contact waits are ``done`` when their finger touches the world or an
+  object, else ``missed`` (``get_*`` and fits: ``done``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from dial.backend.ik import IKError
+from dial.instructions.types import FINGERS
+from dial.parser.script import EventDef
+from dial.preview.places import statement_place
+from dial.preview.scene import HAND, Scene, State, finger_group
+from dial.primitives.arm import Planner, PumaCommand
+from dial.scheduler.types import Outcome
+
+STEP = 0.002  # m: the step of a guarded move's line
+BISECT = 5  # halvings of the last step once a guarded move touches (to 0.06 mm)
+LAG = 0.003  # m: a guarded move whose tool or fingertip lags its line more cannot follow it
+CLOSE_STEP = np.radians(0.5)  # rad: a grasp's closing step
+
+Check = Callable[[], None]  # pose the scene and record its problems
+
+
+@dataclass
+class Report:
+    """What a previewed instruction found: its outcome, and problems (messages)."""
+
+    outcome: Outcome
+    problems: list[str] = field(default_factory=list)
+
+
+class PreviewPuma(PumaCommand):
+    """``puma_command`` planned statement by statement: an unreachable statement is reported
+    (naming the program, its line and the world file's line) and skipped, so that the rest
+    is still previewed; ``labels`` names the statement of each planned segment."""
+
+    labels: list[str]
+    problems: list[str]
+    targets: int  # statements planned, reachable or not
+
+    def plan(self, planner: Planner) -> None:
+        self.labels, self.problems, self.targets = [], [], 1
+        if self.arg("verb") != "ex":
+            super().plan(planner)
+            words = (w.text for p in self.info.event.definition.params for w in p.words)
+            self.labels = [" ".join(words)] * len(planner.segments)
+            return
+        name = str(self.arg("program"))
+        world = self.ctx.world
+        self.targets = len(world.programs[name].statements)
+        for st in world.programs[name].statements:
+            place = statement_place(world.path, name, st.line)
+            where = f"program {name} line {st.line}" + (f", {place}" if place else "")
+            before = len(planner.segments)
+            try:
+                planner.statement(st, where)
+            except IKError as e:
+                self.problems.append(str(e))
+            self.labels += [where] * (len(planner.segments) - before)
+
+    def label_at(self, progress: float) -> str:
+        """The statement the arm follows at ``progress`` (as :meth:`step` picks segments)."""
+        for label, end in zip(self.labels, self.bounds, strict=True):
+            if progress <= end + 1e-12:
+                return label
+        return self.labels[-1] if self.labels else ""
+
+
+def guarded(scene: Scene, event: EventDef, check: Check) -> Report:
+    """A guarded move, stopped at the first touch (see the module's docstring)."""
+    args = event.args
+    finger = args["finger"] if isinstance(args["finger"], int) else None
+    d = np.array([args[k] for k in ("dx", "dy", "dz")], dtype=np.float64)
+    travel = args["max"]
+    length = float(travel) if isinstance(travel, float) else float(np.linalg.norm(d))
+    frame = args.get("frame") or ("tool" if finger is None else "palm")
+    pos, rot = scene.tool()
+    direction = d / np.linalg.norm(d)
+    delta = direction if frame == "world" else rot @ direction
+    robot, ctx = scene.robot, scene.ctx
+    groups = HAND if finger is None else {finger_group(finger)}
+    start = pos if finger is None else scene.tip(finger)
+
+    def reach(s: float) -> float:
+        """Set the effector toward ``start + delta * s``; how far it stays from there (m)."""
+        goal = start + delta * s
+        if finger is None:
+            robot.arm_target = ctx.arm_ik.track(goal, rot, robot.arm_target, 3)
+        else:
+            q = ctx.finger_ik.track(finger, goal, robot.arm_target, robot.hand_target, 3)
+            robot.hand_target[4 * finger : 4 * finger + 4] = q[4 * finger : 4 * finger + 4]
+        scene.pose()
+        where = scene.tool()[0] if finger is None else scene.tip(finger)
+        return float(np.linalg.norm(where - goal))
+
+    s = 0.0
+    while s < length:
+        before = scene.save()
+        s_next = min(length, s + STEP)
+        lag = reach(s_next)
+        check()
+        if scene.touching(groups, held=False):
+            _bisect(scene, before, reach, s, s_next, groups)
+            return Report(Outcome.DONE)
+        if lag > LAG:
+            who = "the tool" if finger is None else f"the {FINGERS[finger]} fingertip"
+            return Report(
+                Outcome.MISSED,
+                [
+                    f"{who} cannot follow the guarded move's line beyond {s * 1000:.0f} mm of "
+                    f"{length * 1000:.0f} mm (it stays {lag * 1000:.1f} mm off: a joint limit, "
+                    "or out of reach)"
+                ],
+            )
+        s = s_next
+    return Report(Outcome.MISSED)
+
+
+def _bisect(
+    scene: Scene,
+    free: State,
+    reach: Callable[[float], float],
+    lo: float,
+    hi: float,
+    groups: set[int] | frozenset[int],
+) -> None:
+    """Narrow the first touch down between travels ``lo`` (free) and ``hi``; end touching."""
+    touching = scene.save()
+    for _ in range(BISECT):
+        mid = (lo + hi) / 2
+        scene.restore(free)
+        reach(mid)
+        if scene.touching(groups, held=False):
+            hi, touching = mid, scene.save()
+        else:
+            lo, free = mid, scene.save()
+    scene.restore(touching)
+
+
+def grasp(scene: Scene, event: EventDef, check: Check) -> Report:
+    """Close the masked joints until each finger touches something or meets its limits."""
+    masks = event.args["masks"]
+    assert isinstance(masks, tuple)
+    jmask, tmask = masks
+    joints = [k for k in range(16) if jmask >> k & 1]
+    fingers = sorted({k // 4 for k in joints})
+    watched = {k // 4 for k in range(16) if tmask >> k & 1} or set(fingers)
+    upper = scene.robot.hand_range[:, 1]
+    target = scene.robot.hand_target
+    stopped: dict[int, set[int]] = {}
+    while True:
+        closing = [k for k in joints if k // 4 not in stopped and target[k] < upper[k]]
+        if not closing:
+            break
+        target[closing] = np.minimum(target[closing] + CLOSE_STEP, upper[closing])
+        scene.pose()
+        check()
+        for f in fingers:
+            if f not in stopped and (touched := scene.touches({finger_group(f)})):
+                stopped[f] = touched
+    lifted = [scene.carryable(g) for touched in stopped.values() for g in touched]
+    bodies = {b for b in lifted if b is not None}
+    if bodies:
+        scene.hold(bodies, list(stopped))
+    return Report(Outcome.DONE if watched <= set(stopped) else Outcome.MISSED)
+
+
+def sense(scene: Scene, event: EventDef) -> Outcome:
+    """A sensing instruction's outcome, predicted from the pose (see the module's docstring)."""
+    finger = event.args.get("finger")
+    if isinstance(finger, int):
+        return Outcome.DONE if scene.touching({finger_group(finger)}) else Outcome.MISSED
+    return Outcome.DONE

@@ -1,0 +1,329 @@
+"""The scene posed kinematically: the robot at its set-points, the objects where they were put.
+
+Nothing is simulated. A pose is set (``qpos``) and checked with ``mj_kinematics`` and
+``mj_collision``: the robot's contacts with the fixed world, with the objects, with itself.
+The robot starts at the world's ``home`` and the objects at their believed poses, as in
+``dial run`` (without the settling). A grasped object is carried rigidly with the palm, with
+any free body inside it (the pitcher's balls), until the hand opens the gripping fingers.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Collection
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from dial.backend.driver import MujocoRobot
+from dial.backend.ik import ArmIK
+from dial.backend.model import ARM_HOME, load_model
+from dial.backend.snapshot import FloatArray
+from dial.engine.setup import scene_bodies
+from dial.instructions.types import FINGERS
+from dial.primitives import Context
+from dial.scene.world import World
+from dial.teach.contacts import FIXED_DEPTH, OBJECT_DEPTH, Parts
+from dial.teach.sim import home_pose
+
+ARM, PALM = 0, 1  # geom groups of the robot; finger f is group 2 + f, anything else -1
+HAND: frozenset[int] = frozenset({PALM, *(2 + f for f in range(len(FINGERS)))})
+SELF_DEPTH = 0.001  # m: fingers may touch each other; deeper, the pose cannot be reached
+RELEASE = np.radians(2.0)  # a gripping finger opened this much lets go of what it holds
+
+
+def finger_group(finger: int) -> int:
+    return 2 + finger
+
+
+_PART = {
+    ARM: "arm",
+    PALM: "palm",
+    **{2 + f: name if name == "thumb" else f"{name} finger" for f, name in enumerate(FINGERS)},
+}
+
+
+def _effectors(*groups: int) -> tuple[str, ...]:
+    """The effectors that move robot parts of ``groups``: the arm moves the arm and the palm."""
+    return tuple("arm" if g in (ARM, PALM) else FINGERS[g - 2] for g in groups)
+
+
+@dataclass(frozen=True)
+class Hit:
+    """A contact the preview reports: the effectors that made it, what, and how deep (m)."""
+
+    effectors: tuple[str, ...]  # "arm" or fingers
+    key: tuple[str, str, str]  # (kind, robot part, other part): one report per pair and run
+    text: str  # "the arm hits pour_table (puma_link5 and pour_table_top)"
+    depth: float
+
+
+@dataclass(frozen=True)
+class Held:
+    """Bodies carried with the palm: their poses in the tool frame, and the grip holding them."""
+
+    bodies: tuple[int, ...]
+    adr: np.ndarray  # (N, 7) qpos addresses of each body's free joint
+    pos: FloatArray  # (N, 3) positions in the tool frame
+    quat: FloatArray  # (N, 4) orientations in the tool frame
+    fingers: frozenset[int]
+    closed: FloatArray  # (16,) the hand's joint angles when it closed
+
+
+@dataclass(frozen=True)
+class State:
+    """Everything :meth:`Scene.restore` needs to go back: set-points, objects, grips."""
+
+    arm: FloatArray
+    hand: FloatArray
+    qpos: FloatArray
+    held: tuple[Held, ...]
+
+
+class Scene:
+    """One scene's model and data, posed kinematically; the robot starts at ``home``."""
+
+    def __init__(self, world: World) -> None:
+        self.world = world
+        self.model = model = load_model(world.model_path)
+        self.data = data = mujoco.MjData(model)
+        mujoco.mj_forward(model, data)
+        believed = {
+            model.body(b).name: (data.xpos[b].copy(), data.xmat[b].reshape(3, 3).copy())
+            for b in scene_bodies(model, world)
+        }
+        self.robot = robot = MujocoRobot(model, data)
+        self.index = robot.index
+        ik = ArmIK()
+        pos, rot = home_pose(world, believed)
+        home = ik.solve(pos, rot, np.array(ARM_HOME), "the start pose (location 'home')")
+        robot.arm_target = home
+        self.ctx = Context(robot, world, believed, ik)
+        self.parts = parts = Parts.of(model, robot.index)
+        names = [model.body(b).name for b in range(model.nbody)]
+        group = np.where(parts.arm, ARM, np.where(parts.robot, PALM, -1))
+        for f, finger in enumerate(FINGERS):
+            mine = np.array([names[b].startswith(f"hand_{finger}_") for b in model.geom_bodyid])
+            group[mine & parts.robot] = finger_group(f)
+        self.group = group
+        _robot_contacts_only(model, parts.robot)
+        self.root = model.body_rootid[model.geom_bodyid]  # each geom's top body
+        self.held: tuple[Held, ...] = ()
+        self.pose()
+
+    # -- posing ------------------------------------------------------------------------------------
+    def pose(self) -> None:
+        """Put the robot at its set-points (carrying what it holds) and find the contacts."""
+        m, d, ix, r = self.model, self.data, self.index, self.robot
+        # The servos stop at the joint limits (a target beyond one is reported by the checks).
+        d.qpos[ix.arm_qpos] = np.clip(r.arm_target, r.arm_range[:, 0], r.arm_range[:, 1])
+        d.qpos[ix.hand_qpos] = np.clip(r.hand_target, r.hand_range[:, 0], r.hand_range[:, 1])
+        mujoco.mj_kinematics(m, d)
+        if self.held:
+            self._let_go()
+            self._carry()
+            mujoco.mj_kinematics(m, d)
+        mujoco.mj_collision(m, d)
+
+    def tool(self) -> tuple[FloatArray, FloatArray]:
+        """The tool pose at the current pose: position (3,) m, rotation (3, 3)."""
+        site = self.index.tool_site
+        return self.data.site_xpos[site].copy(), self.data.site_xmat[site].reshape(3, 3).copy()
+
+    def tip(self, finger: int) -> FloatArray:
+        tip: FloatArray = self.data.site_xpos[self.index.fingertip_sites[finger]].copy()
+        return tip
+
+    # -- contacts ----------------------------------------------------------------------------------
+    def _contacts(self) -> list[tuple[int, int, float]]:
+        """(robot geom, other geom, depth m) of every penetrating contact of the robot."""
+        n = self.data.ncon
+        if n == 0:
+            return []
+        c = self.data.contact
+        g1, g2, dist = c.geom1[:n], c.geom2[:n], c.dist[:n]
+        keep = ((self.group[g1] >= 0) | (self.group[g2] >= 0)) & (dist < 0)
+        out = []
+        for a, b, d in zip(g1[keep], g2[keep], dist[keep], strict=True):
+            ga, gb = self.group[a], self.group[b]
+            first = ga >= 0 and (gb < 0 or ga <= gb)  # the robot's geom first, the arm's first
+            out.append((int(a), int(b), -float(d)) if first else (int(b), int(a), -float(d)))
+        return out
+
+    def touches(self, groups: Collection[int], held: bool = True) -> set[int]:
+        """The geoms that geoms of ``groups`` touch now (other robot parts included); without
+        ``held``, not those of what the hand holds."""
+        skip = set() if held else self.held_bodies()
+        out: set[int] = set()
+        for a, b, _ in self._contacts():
+            for mine, other in ((a, b), (b, a)):
+                mine_in = self.group[mine] in groups
+                if mine_in and self.group[other] not in groups and self.root[other] not in skip:
+                    out.add(other)
+        return out
+
+    def touching(self, groups: Collection[int], held: bool = True) -> bool:
+        """Whether parts of ``groups`` touch the world or an object (not the robot; without
+        ``held``, not what the hand holds)."""
+        return any(self.group[g] < 0 for g in self.touches(groups, held))
+
+    def hits(self) -> list[Hit]:
+        """The contacts that are problems (see docs/debugging.md), one per pair of parts."""
+        held = self.held_bodies()
+        out = []
+        for a, b, depth in self._contacts():
+            ga, gb = int(self.group[a]), int(self.group[b])
+            pair = f"{self._name(a)} and {self._name(b)}"
+            if gb >= 0:  # the robot against itself (parent and child never collide)
+                if ga == gb or depth <= SELF_DEPTH:
+                    continue
+                if ga == ARM:
+                    text = f"the hand hits the arm ({pair})"
+                elif ga == PALM:
+                    text = f"the {_PART[gb]} runs into the palm ({pair})"
+                else:
+                    text = f"the {_PART[ga]} and the {_PART[gb]} collide ({pair})"
+                out.append(Hit(_effectors(ga, gb), ("self", _PART[ga], _PART[gb]), text, depth))
+                continue
+            if self.root[b] in held:
+                continue
+            other = self._other(b)
+            if ga == ARM:
+                kind, text = "arm", f"the arm hits {other} ({pair})"
+            elif self.parts.fixed[b] and depth > FIXED_DEPTH:
+                kind, text = "fixed", f"the {_PART[ga]} presses into {other} ({pair})"
+            elif not self.parts.fixed[b] and depth > OBJECT_DEPTH:
+                kind, text = "object", f"the {_PART[ga]} pushes into {other} ({pair})"
+            else:
+                continue
+            part = "arm" if ga == ARM else "hand"  # one report per object, whichever finger
+            out.append(Hit(_effectors(ga), (kind, part, other), text, depth))
+        return out
+
+    def _name(self, geom: int) -> str:
+        return self.parts.geom[geom]
+
+    def _other(self, geom: int) -> str:
+        """An object by its body's name; the world body's own geoms (the floor) by theirs."""
+        body = self.parts.body[geom]
+        return self.parts.geom[geom] if body == "world" else body
+
+    # -- holding -----------------------------------------------------------------------------------
+    def held_bodies(self) -> set[int]:
+        return {b for h in self.held for b in h.bodies}
+
+    def carryable(self, geom: int) -> int | None:
+        """The free body a grasp on ``geom`` would lift, or None (the robot, a fixed body, or
+        one clamped to the world by a weld)."""
+        m = self.model
+        if self.group[geom] >= 0:
+            return None
+        body = int(self.root[geom])
+        joint = int(m.body_jntadr[body])
+        if joint < 0 or m.jnt_type[joint] != mujoco.mjtJoint.mjJNT_FREE:
+            return None
+        for e in range(m.neq):
+            if m.eq_type[e] != mujoco.mjtEq.mjEQ_WELD or not m.eq_active0[e]:
+                continue
+            pair = (int(m.eq_obj1id[e]), int(m.eq_obj2id[e]))
+            if body in pair and m.body_weldid[pair[0] + pair[1] - body] == 0:
+                return None
+        return body
+
+    def hold(self, bodies: Collection[int], fingers: Collection[int]) -> None:
+        """Carry ``bodies`` (and the free bodies inside them) with the palm from now on."""
+        m, d = self.model, self.data
+        carried = sorted(set(bodies) | self._contents(bodies))
+        pos, rot = self.tool()
+        adr = m.jnt_qposadr[m.body_jntadr[carried]][:, None] + np.arange(7)
+        quat = np.empty((len(carried), 4))
+        for i, b in enumerate(carried):
+            mujoco.mju_mat2Quat(quat[i], (rot.T @ d.xmat[b].reshape(3, 3)).reshape(-1))
+        offsets = (d.xpos[carried] - pos) @ rot
+        hand = self.robot.hand_target.copy()
+        grip = Held(tuple(carried), adr, offsets, quat, frozenset(fingers), hand)
+        self.held = (*self.held, grip)
+
+    def _contents(self, bodies: Collection[int]) -> set[int]:
+        """Free bodies whose origin lies inside the box bounding a body's geoms."""
+        m, d = self.model, self.data
+        inside: set[int] = set()
+        for body in bodies:
+            geoms = [g for g in range(m.ngeom) if m.geom_bodyid[g] == body]
+            if not geoms:
+                continue
+            boxes = [_box(m, d, g) for g in geoms]
+            lo = np.min([b[0] for b in boxes], axis=0)
+            hi = np.max([b[1] for b in boxes], axis=0)
+            for other in range(1, m.nbody):
+                if other in bodies or m.body_rootid[other] != other or other == body:
+                    continue
+                joint = int(m.body_jntadr[other])
+                if joint < 0 or m.jnt_type[joint] != mujoco.mjtJoint.mjJNT_FREE:
+                    continue
+                p = d.xpos[other]
+                if np.all(p >= lo) and np.all(p <= hi):
+                    inside.add(other)
+        return inside
+
+    def _let_go(self) -> None:
+        """Drop the grips whose fingers opened."""
+        flex = self.robot.hand_target
+        kept = []
+        for grip in self.held:
+            joints = [4 * f + j for f in grip.fingers for j in (1, 2, 3)]
+            if not np.any(flex[joints] < grip.closed[joints] - RELEASE):
+                kept.append(grip)
+        self.held = tuple(kept)
+
+    def _carry(self) -> None:
+        pos, rot = self.tool()
+        tool = np.empty(4)
+        mujoco.mju_mat2Quat(tool, rot.reshape(-1))
+        for grip in self.held:
+            self.data.qpos[grip.adr[:, :3]] = pos + grip.pos @ rot.T
+            self.data.qpos[grip.adr[:, 3:]] = _quat_products(tool, grip.quat)
+
+    # -- branches ----------------------------------------------------------------------------------
+    def save(self) -> State:
+        r = self.robot
+        return State(r.arm_target.copy(), r.hand_target.copy(), self.data.qpos.copy(), self.held)
+
+    def restore(self, state: State) -> None:
+        self.robot.arm_target = state.arm.copy()
+        self.robot.hand_target = state.hand.copy()
+        self.data.qpos[:] = state.qpos
+        self.held = state.held
+        self.pose()
+
+
+def _robot_contacts_only(model: mujoco.MjModel, robot: np.ndarray) -> None:
+    """Keep the robot's contacts (with anything) and drop those between objects, which the
+    preview never looks at: bit 2 pairs the robot's colliding geoms with every other one."""
+    colliding = (model.geom_contype | model.geom_conaffinity) != 0
+    model.geom_contype[colliding & robot] |= 2
+    model.geom_contype[colliding & ~robot] = 0
+    model.geom_conaffinity[colliding & ~robot] = 2
+
+
+def _quat_products(a: FloatArray, b: FloatArray) -> FloatArray:
+    """The quaternion products a * b[i] (w, x, y, z), for one ``a`` (4,) and ``b`` (N, 4)."""
+    w, x, y, z = a
+    bw, bx, by, bz = b.T
+    return np.stack(
+        [
+            w * bw - x * bx - y * by - z * bz,
+            w * bx + x * bw + y * bz - z * by,
+            w * by - x * bz + y * bw + z * bx,
+            w * bz + x * by - y * bx + z * bw,
+        ],
+        axis=1,
+    )
+
+
+def _box(m: mujoco.MjModel, d: mujoco.MjData, geom: int) -> tuple[FloatArray, FloatArray]:
+    """The corners (lowest, highest) of the world-axes box bounding one geom as posed."""
+    rot = d.geom_xmat[geom].reshape(3, 3)
+    centre = d.geom_xpos[geom] + rot @ m.geom_aabb[geom, :3]
+    half = np.abs(rot) @ m.geom_aabb[geom, 3:]
+    return centre - half, centre + half

@@ -1,0 +1,56 @@
+"""The table of active runs: what a started run carries while the tick loop steps it."""
+
+from __future__ import annotations
+
+from typing import Generic, NamedTuple
+
+from dial.parser.script import Script
+from dial.scheduler.types import Ended, Primitive, RunInfo, S
+
+
+class ActiveRun(Generic[S]):
+    """One started run in the table: its primitive and where it sits in time."""
+
+    __slots__ = (
+        "ended",
+        "fixed",
+        "info",
+        "prim",
+        "script",
+        "span",
+        "start_clock",
+        "start_period",
+        "start_tick",
+        "timeout",
+    )
+
+    def __init__(
+        self, script: Script, plan: RunPlan, prim: Primitive[S], tick: int, periods: int, clock: int
+    ) -> None:
+        self.script, self.info, self.prim = script, plan.info, prim
+        self.span, self.fixed, self.timeout = plan.span, plan.fixed, plan.timeout
+        self.start_tick = tick
+        self.start_period, self.start_clock = periods, clock  # periods, tick-time periods
+        self.ended: Ended | None = None
+
+
+class RunPlan(NamedTuple):
+    """What a run's place in the script fixes, worked out once per run of the timeline."""
+
+    info: RunInfo
+    span: int  # its executing ticks, in periods
+    fixed: bool  # fixed-length: it ends with its last executing tick
+    timeout: float | None  # s; only indeterminate runs time out
+
+    @classmethod
+    def of(cls, info: RunInfo) -> RunPlan:
+        run, event = info.run, info.event
+        fixed = event.instruction.length == "fixed"
+        timeout = event.args.get("timeout")
+        usable = not fixed and isinstance(timeout, int | float)
+        return cls(
+            info,
+            (run.exec_end - run.start + 1) * info.periods_per_tick,
+            fixed,
+            float(timeout) if usable else None,  # type: ignore[arg-type]
+        )

@@ -1,0 +1,157 @@
+"""Save at a block boundary and resume exactly (DESIGN 6.1): the continuation's records and
+final state are the uninterrupted run's, byte for byte apart from wall time."""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import pytest
+
+import dial
+from dial.cli import main
+from dial.engine import RunResult
+
+from ..conftest import ROOT
+
+
+def _records(result: RunResult) -> list[dict[str, object]]:
+    """The log as JSON text would hold it, without the summary's wall time."""
+    out = []
+    for record in result.log.records:
+        record = json.loads(json.dumps(record))
+        record.pop("wall_time", None)
+        out.append(record)
+    return out
+
+
+def _check_exact(script: str, scene: str | None, block: int, tmp_path: Path) -> None:
+    state = tmp_path / f"{Path(script).stem}-{block}.state"
+    full = dial.run(dial.load(script, scene=scene), save_at=(block, state))
+    assert full.saved == ((block, state),), "the save point was never reached"
+    resumed = dial.run(dial.load(script, scene=scene), resume=state)
+    tail = [r for r in _records(resumed) if r["kind"] not in ("scene", "resume")]
+    assert tail == _records(full)[-len(tail) :]
+    assert resumed.final_qpos == full.final_qpos  # bit for bit
+    assert resumed.ok == full.ok and resumed.summary.sim_time == full.summary.sim_time
+    assert len(tail) < len(_records(full)) - 2  # it did not simply run everything again
+
+
+@pytest.mark.parametrize(
+    ("script", "scene", "block"),
+    [
+        ("lightbulb.dial", None, 5),  # a block inside '@repeat 4' (its second iteration)
+        ("lightbulb.dial", None, 8),  # the block after the repeat
+        ("explore_surface.dial", None, 20),  # inside '@repeat until' loops and '@if'
+        ("explore.dial", "explore_block", 3),  # before the branch that @calls a procedure
+        ("reactions.dial", None, 3),  # inside a reaction
+    ],
+)
+def test_resume_is_exact(script: str, scene: str | None, block: int, tmp_path: Path) -> None:
+    _check_exact(script, scene, block, tmp_path)
+
+
+@pytest.fixture(scope="module")
+def saved(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
+    """A copy of lightbulb.dial (and its world) and a state saved before its block 8."""
+    folder = tmp_path_factory.mktemp("edits")
+    script = folder / "lightbulb.dial"
+    shutil.copy(ROOT / "scripts" / "lightbulb.dial", script)
+    state = folder / "lb.state"
+    assert main(["run", str(script), "--save-at", "block:8", str(state), "--quiet"]) == 0
+    return script, state
+
+
+def test_resuming_an_edited_later_block_runs_the_edit(
+    saved: tuple[Path, Path], tmp_path: Path
+) -> None:
+    script, state = saved
+    edited = tmp_path / "lightbulb.dial"
+    text = script.read_text()
+    # The last block (line 94 on): retract 10 ticks -> a shorter, 6-tick retract.
+    assert "retract_arm            #=========\n" in text
+    edited.write_text(
+        text.replace("retract_arm            #=========\n", "retract_arm            #=====\n")
+    )
+    before = dial.run(dial.load(script), resume=state)
+    after = dial.run(dial.load(edited), resume=state)
+    assert after.summary.ticks == before.summary.ticks - 4
+    ends = [r for r in after.log.of("end") if r["event"] == "retract_arm"]
+    assert ends and ends[-1]["outcome"] == "done"
+
+
+def test_an_edited_earlier_line_is_named(
+    saved: tuple[Path, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    script, state = saved
+    edited = tmp_path / "lightbulb.dial"
+    lines = script.read_text().split("\n")
+    lines[57] = lines[57] + "  // a comment is a change too"  # line 58
+    edited.write_text("\n".join(lines))
+    assert main(["run", str(edited), "--resume", str(state), "--quiet"]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith(f"dial: {edited}:58:1: this line changed since the state was saved")
+    assert err.count("\n") == 1 and "Traceback" not in err
+
+
+@pytest.mark.parametrize(
+    ("damage", "message"),
+    [
+        (lambda s: s[: len(s) // 2], "is corrupt or truncated (not JSON)"),
+        (lambda s: s.replace('"version": 1', '"version": 99'), "has format version 99"),
+        (lambda s: s.replace('"counts"', '"countz"'), "is corrupt or truncated ('counts')"),
+        (lambda s: "\x00\x01binary", "is corrupt or truncated (not JSON)"),
+        (lambda s: "[1, 2]", "is not a dial state file"),
+    ],
+)
+def test_a_bad_state_file_is_one_line_and_exit_1(
+    saved: tuple[Path, Path],
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    damage: object,
+    message: str,
+) -> None:
+    script, state = saved
+    bad = tmp_path / "bad.state"
+    bad.write_text(damage(state.read_text()))  # type: ignore[operator]
+    assert main(["run", str(script), "--resume", str(bad), "--quiet"]) == 1
+    err = capsys.readouterr().err
+    assert message in err and err.count("\n") == 1 and "Traceback" not in err
+
+
+def test_a_state_file_of_another_script(
+    saved: tuple[Path, Path], capsys: pytest.CaptureFixture[str]
+) -> None:
+    _, state = saved
+    assert main(["run", "pour.dial", "--resume", str(state), "--quiet"]) == 1
+    err = capsys.readouterr().err
+    assert err == (
+        f"dial: state file '{state}' was saved from script 'lightbulb.dial', not 'pour.dial'\n"
+    )
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["--save-at", "block:0", "x.state"], "--save-at: expected block:N FILE"),
+        (["--save-at", "tick:3", "x.state"], "--save-at: expected block:N FILE"),
+        (["--resume", "x.state", "--tick", "0.1"], "--resume takes the tick, seed"),
+        (["--break", "nosuch"], "--break nosuch: no event 'nosuch' in the script"),
+        (["--break", "tick:0"], "--break tick:0: expected tick:N"),
+    ],
+)
+def test_debugging_usage_errors(
+    argv: list[str], message: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    assert main(["run", "lightbulb.dial", *argv, "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"dial: {message}") and err.count("\n") == 1
+
+
+def test_a_save_point_never_reached_is_an_error(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    state = tmp_path / "x.state"
+    assert main(["run", "reactions.dial", "--save-at", "block:9", str(state), "--quiet"]) == 1
+    assert "nothing was saved" in capsys.readouterr().err and not state.exists()

@@ -1,0 +1,58 @@
+"""``dial check`` reads a scene's model without MuJoCo: a malformed model, or a world object
+that names no body, is a caret error at ``@scene`` (issue 15), not a traceback at run time."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from dial.backend.model import load_model
+from dial.errors import ScriptError
+from dial.parser import check_text
+from dial.scene import bundled_scene_names, load_scene_names, load_world, models_dir, worlds_dir
+from dial.scene.mjcf import body_names
+
+from .conftest import write
+
+SCENE_XML = (models_dir() / "utah_hand_puma" / "scene_surface.xml").as_posix()
+SCRIPT = '@scene w.toml\n% go puma_command "moves above_block"\n\ngo #\n'
+
+
+@pytest.mark.parametrize("name", bundled_scene_names())
+def test_body_names_are_those_mujoco_compiles(name: str) -> None:
+    world = load_world(worlds_dir() / f"{name}.toml")
+    model = load_model(world.model_path)
+    compiled = {model.body(i).name for i in range(model.nbody)} - {"world"}
+    assert body_names(world.model_path) == compiled
+
+
+def _check(tmp_path: Path, model: str, block: str = "surface_block") -> list[str]:
+    write(
+        tmp_path / "w.toml",
+        f'extends = "surface"\n[scene]\nmodel = "{model}"\n[objects]\nblock = "{block}"\n',
+    )
+    with pytest.raises(ScriptError) as info:
+        check_text(SCRIPT, str(tmp_path / "s.dial"), loader=load_scene_names)
+    return [d.header for d in info.value.diagnostics]
+
+
+def test_a_malformed_model_is_an_error_at_scene(tmp_path: Path) -> None:
+    write(tmp_path / "scene.xml", f'<mujoco>\n  <include file="{SCENE_XML}"/>\n  <worldbody>\n')
+    (header,) = _check(tmp_path, "scene.xml")
+    assert header.startswith(f"{tmp_path / 's.dial'}:1:8: scene 'w.toml' has a bad world file: ")
+    assert header.endswith(f"{tmp_path / 'scene.xml'}: malformed XML at line 4, column 1")
+
+
+def test_a_missing_include_is_an_error_at_scene(tmp_path: Path) -> None:
+    write(tmp_path / "scene.xml", '<mujoco><include file="gone.xml"/></mujoco>')
+    (header,) = _check(tmp_path, "scene.xml")
+    assert header.endswith(f"{tmp_path / 'scene.xml'}: model file 'gone.xml' not found")
+
+
+def test_an_object_naming_no_body_is_an_error_at_scene(tmp_path: Path) -> None:
+    (header,) = _check(tmp_path, SCENE_XML, block="surface_blok")
+    assert header.endswith(
+        f"{tmp_path / 'w.toml'}: objects.block: no body 'surface_blok' in scene_surface.xml; "
+        "did you mean 'surface_block' or 'surface_table'?"
+    )
