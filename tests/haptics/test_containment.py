@@ -69,12 +69,13 @@ def test_containment_fits_the_displaced_solid_within_a_minute(
     assert np.linalg.norm(shift) == pytest.approx(0.010, abs=1e-5)
     centre = np.array(summary["results"]["contain"]["centre"])
     assert np.linalg.norm(centre - (np.array(BELIEVED[scene]) + shift)) < 0.003
-    # Contacts from both fingers: the index on the top, the thumb down the sides.
+    # Contacts from both fingers: the index on the top (taxels or links), the thumb down the
+    # sides.
     recorded = [r for r in records if r["kind"] == "end" and r["outcome"] == "done"]
-    marks = [r for r in recorded if r["event"] == "mark"]
+    top = [r for r in recorded if r["event"] in ("mark", "rim")]
     sides = [r for r in recorded if r["event"] in ("note", "edge")]
-    assert len(marks) >= 3 and len(sides) >= 16
-    assert summary["results"]["contain"]["count"] == len(marks) + len(sides)
+    assert len(top) >= 3 and len(sides) >= 16
+    assert summary["results"]["contain"]["count"] == len(top) + len(sides)
 
 
 def test_side_locations_put_the_thumb_pad_where_the_world_file_says() -> None:

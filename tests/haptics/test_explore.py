@@ -14,8 +14,10 @@ import pytest
 from .test_procedures import _run
 
 SURFACE, CONTAIN = "scripts/explore_surface.dial", "scripts/containment.dial"
-# The procedures' own calls: containment.dial runs one side per azimuth.
-NESTED = {SURFACE: [], CONTAIN: ["scripts/containment_side.dial"] * 8}
+# The procedures' own calls: containment.dial presses the top five times, then runs one side
+# per azimuth.
+TOP, SIDE = "scripts/containment_top.dial", "scripts/containment_side.dial"
+NESTED = {SURFACE: [], CONTAIN: [TOP] * 5 + [SIDE] * 8}
 
 
 # The pad starts 116.3 mm above the object's centre (20 mm south of it); the first touch is
