@@ -7,6 +7,8 @@ one: a straight-line move solves one waypoint per control period.
 
 from __future__ import annotations
 
+from collections import OrderedDict
+
 import mink
 import mujoco
 import numpy as np
@@ -23,6 +25,44 @@ ROT_TOL = 2e-3  # rad
 
 class IKError(DialError):
     """A target the arm or a finger cannot reach; the message says how far off it stays."""
+
+
+class _Memo:
+    """Solutions already found in this process, by their exact inputs.
+
+    A solve depends only on its inputs (the solvers keep no state between calls that
+    changes a result), so a repeated problem gives back the very same array: the runs of a
+    script in one process (a sweep's trials, a notebook, a benchmark) solve the same
+    targets, since locations follow the *believed* object poses. Bounded, oldest first out.
+    """
+
+    SIZE = 50_000
+
+    def __init__(self) -> None:
+        self._values: OrderedDict[tuple[object, ...], object] = OrderedDict()
+
+    @staticmethod
+    def key(kind: str, *parts: object) -> tuple[object, ...]:
+        return (
+            kind,
+            *(
+                np.ascontiguousarray(p, dtype=np.float64).tobytes()
+                if isinstance(p, np.ndarray)
+                else p
+                for p in parts
+            ),
+        )
+
+    def get(self, key: tuple[object, ...]) -> object:
+        return self._values.get(key)
+
+    def put(self, key: tuple[object, ...], value: object) -> None:
+        self._values[key] = value
+        if len(self._values) > self.SIZE:
+            self._values.popitem(last=False)
+
+
+_MEMO = _Memo()
 
 
 class _Base:
@@ -82,9 +122,15 @@ class ArmIK(_Base):
         self, pos: FloatArray, rot: FloatArray, arm_q: FloatArray, iterations: int = 2
     ) -> FloatArray:
         """A few warm-started steps from ``arm_q`` toward the pose: one waypoint of a line."""
+        key = _Memo.key("arm-track", pos, rot, arm_q, iterations)
+        known = _MEMO.get(key)
+        if isinstance(known, np.ndarray):
+            return known.copy()
         self._set(arm_q)
         self._iterate(pos, rot, iterations)
-        return self.config.q[self.index.arm_qpos].copy()
+        q: FloatArray = self.config.q[self.index.arm_qpos].copy()
+        _MEMO.put(key, q.copy())
+        return q
 
     def solve(self, pos: FloatArray, rot: FloatArray, arm_q: FloatArray, what: str) -> FloatArray:
         """Converge on the pose; raise :class:`IKError` if it is out of reach.
@@ -95,14 +141,20 @@ class ArmIK(_Base):
         converges wins. Deterministic.
         """
         start = np.asarray(arm_q, dtype=np.float64)
-        closest = (np.inf, np.inf)
-        for offset in _SEEDS:
+        key = _Memo.key("arm-solve", pos, rot, start)
+        known = _MEMO.get(key)
+        closest = known if isinstance(known, tuple) else (np.inf, np.inf)
+        if isinstance(known, np.ndarray):
+            return known.copy()
+        for offset in _SEEDS if known is None else ():
             self._set(start + offset)
             perr, rerr = self._iterate(pos, rot, 200)
             if perr <= 2e-3 and rerr <= 1e-2:
                 q: FloatArray = self.config.q[self.index.arm_qpos].copy()
+                _MEMO.put(key, q.copy())
                 return q
             closest = min(closest, (perr, rerr))
+        _MEMO.put(key, closest)
         raise IKError(
             f"{what} is out of the arm's reach: the tool stays {closest[0] * 1000:.1f} mm "
             f"and {np.degrees(closest[1]):.1f} deg away"
@@ -160,6 +212,10 @@ class FingerIK(_Base):
         iterations: int = 2,
     ) -> FloatArray:
         """Steps from ``hand_q`` moving the fingertip toward ``tip`` (world, m); returns (16,)."""
+        key = _Memo.key("finger-track", finger, tip, arm_q, hand_q, iterations)
+        known = _MEMO.get(key)
+        if isinstance(known, np.ndarray):
+            return known.copy()
         self._set(arm_q, hand_q)
         task = self.tasks[finger]
         # Position only: keep the tip's own orientation in the target, since mink's frame error
@@ -182,4 +238,6 @@ class FingerIK(_Base):
                 constraints=[self.constraints[finger]],
             )
             self.config.integrate_inplace(vel, DT)
-        return self.config.q[self.index.hand_qpos].copy()
+        q: FloatArray = self.config.q[self.index.hand_qpos].copy()
+        _MEMO.put(key, q.copy())
+        return q

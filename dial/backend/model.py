@@ -16,6 +16,7 @@ import mujoco
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from dial.errors import DialError
 from dial.resources import data_dir
 
 ROBOT_DIR = data_dir("models") / "utah_hand_puma"
@@ -51,11 +52,19 @@ def load_model_from_string(xml: str) -> mujoco.MjModel:
     return mujoco.MjModel.from_xml_string(xml, _robot_files())
 
 
+class ModelError(DialError, KeyError):
+    """A model that lacks a part of the robot dial drives (a scene without the hand, say)."""
+
+    def __str__(self) -> str:  # KeyError would quote the message
+        return str(self.args[0])
+
+
 def _ids(model: mujoco.MjModel, kind: mujoco.mjtObj, names: tuple[str, ...]) -> IntArray:
     ids = np.array([mujoco.mj_name2id(model, kind, name) for name in names], dtype=np.intp)
     missing = [name for name, i in zip(names, ids, strict=True) if i < 0]
     if missing:
-        raise KeyError(f"model has no {kind.name.removeprefix('mjOBJ_').lower()} {missing}")
+        what = kind.name.removeprefix("mjOBJ_").lower()
+        raise ModelError(f"the model has no {what} {', '.join(missing)} of dial's robot")
     ids.flags.writeable = False
     return ids
 
@@ -100,7 +109,7 @@ class RobotIndex:
 
     @classmethod
     def from_model(cls, model: mujoco.MjModel) -> RobotIndex:
-        """Look up every name; raise KeyError naming the parts the model lacks."""
+        """Look up every name; raise :class:`ModelError` naming the parts the model lacks."""
         arm = _ids(model, mujoco.mjtObj.mjOBJ_JOINT, ARM_JOINTS)
         hand = _ids(model, mujoco.mjtObj.mjOBJ_JOINT, HAND_JOINTS)
         tendons = _ids(model, mujoco.mjtObj.mjOBJ_ACTUATOR, TENDONS)

@@ -8,6 +8,7 @@ from typing import NamedTuple
 import numpy as np
 from numpy.typing import NDArray
 
+from dial.geometry import matrix_rpy
 from dial.instructions.types import FINGERS
 
 FloatArray = NDArray[np.float64]
@@ -40,14 +41,6 @@ class PausedView(NamedTuple):
     tactile: FloatArray
 
 
-def _rpy(rot: FloatArray) -> tuple[float, float, float]:
-    """Fixed-axis roll, pitch, yaw (deg) of a rotation, as world files write them."""
-    pitch = np.arcsin(-np.clip(rot[2, 0], -1.0, 1.0))
-    roll = np.arctan2(rot[2, 1], rot[2, 2])
-    yaw = np.arctan2(rot[1, 0], rot[0, 0])
-    return float(np.degrees(roll)), float(np.degrees(pitch)), float(np.degrees(yaw))
-
-
 def state_text(view: PausedView) -> str:
     lines = [f"tick {view.tick}, t = {view.sim_time:.3f} s (control period {view.periods})"]
     lines.append("running:" if view.active else "running: nothing")
@@ -60,7 +53,7 @@ def state_text(view: PausedView) -> str:
         outcomes = ", ".join(f"{e} {o}" for e, o in view.latest)
         lines.append(f"latest outcomes: {outcomes}")
     x, y, z = (float(v) for v in view.tool_pos)
-    roll, pitch, yaw = _rpy(view.tool_rot)
+    roll, pitch, yaw = matrix_rpy(view.tool_rot)
     lines.append(
         f"tool: x {x:.4f}  y {y:.4f}  z {z:.4f} m   rpy {roll:.1f} {pitch:.1f} {yaw:.1f} deg"
     )

@@ -227,6 +227,12 @@ class Saved:
 
     def restore(self, robot: MujocoRobot, ctx: Context) -> None:
         """Put the saved physics, driver and recorded sets back (on the same scene)."""
+        try:
+            self._restore(robot, ctx)
+        except (KeyError, TypeError, ValueError) as e:  # base64, sizes, missing fields
+            raise StateFileError(f"state file '{self.source}' is corrupt ({e})") from None
+
+    def _restore(self, robot: MujocoRobot, ctx: Context) -> None:
         d = self.data
         m = robot.model
         physics = d["physics"]

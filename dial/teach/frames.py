@@ -2,14 +2,12 @@
 
 from __future__ import annotations
 
-import math
 from collections.abc import Iterable
 
-import numpy as np
-
 from dial.backend.snapshot import FloatArray
+from dial.geometry import matrix_rpy
 
-GIMBAL = 1e-3  # cos(pitch) below this: pitch is +-90 deg, and only roll -/+ yaw is defined
+__all__ = ["deg_text", "fixed", "half_turn", "matrix_rpy", "mm_text", "relative"]
 
 
 def fixed(value: float, digits: int = 1) -> str:
@@ -30,36 +28,6 @@ def half_turn(deg: float) -> float:
 def deg_text(angles: Iterable[float]) -> str:
     """``[r, p, y]`` of angles already in degrees."""
     return "[" + ", ".join(fixed(half_turn(v)) for v in angles) + "]"
-
-
-def matrix_rpy(rot: FloatArray) -> tuple[float, float, float]:
-    """Roll, pitch, yaw (deg) with ``rot = Rz(yaw) Ry(pitch) Rx(roll)``, the inverse of
-    :func:`dial.geometry.rpy_matrix`.
-
-    Of the two solutions, the one with the smaller roll and yaw is taken (a hand pointing
-    down is ``[0, 180, 0]``, not ``[180, 0, 180]``); at pitch +-90 deg yaw is taken as 0.
-    """
-    r = np.asarray(rot, dtype=np.float64)
-    pitch = math.asin(max(-1.0, min(1.0, -r[2, 0])))
-    if math.cos(pitch) < GIMBAL:
-        pitch = math.copysign(math.pi / 2, pitch)
-        sign = 1.0 if pitch > 0 else -1.0
-        roll, yaw = math.atan2(sign * r[0, 1], r[1, 1]), 0.0
-    else:
-        roll, yaw = math.atan2(r[2, 1], r[2, 2]), math.atan2(r[1, 0], r[0, 0])
-        flipped = (_wrap(roll + math.pi), math.pi - pitch, _wrap(yaw + math.pi))
-        if max(abs(flipped[0]), abs(flipped[2])) < max(abs(roll), abs(yaw)) - 1e-9:
-            roll, pitch, yaw = flipped
-    return (
-        math.degrees(roll) + 0.0,
-        math.degrees(_wrap(pitch)) + 0.0,
-        math.degrees(yaw) + 0.0,
-    )
-
-
-def _wrap(angle: float) -> float:
-    """The angle in (-pi, pi]."""
-    return math.pi - (math.pi - angle) % (2 * math.pi)
 
 
 def relative(

@@ -44,7 +44,8 @@ def _check_exact(script: str, scene: str | None, block: int, tmp_path: Path) -> 
         ("lightbulb.dial", None, 5),  # a block inside '@repeat 4' (its second iteration)
         ("lightbulb.dial", None, 8),  # the block after the repeat
         ("explore_surface.dial", None, 20),  # inside '@repeat until' loops and '@if'
-        ("explore.dial", "explore_block", 3),  # before the branch that @calls a procedure
+        ("explore.dial", "explore_block", 2),  # the @call of a procedure comes after it
+        ("explore.dial", "explore_block", 4),  # inside the called procedure
         ("reactions.dial", None, 3),  # inside a reaction
     ],
 )
