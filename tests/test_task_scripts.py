@@ -26,39 +26,39 @@ def test_show_chart_is_pinned(name: str, in_root: Path, capsys: pytest.CaptureFi
 
 def test_lightbulb_tick_ranges_follow_the_paper() -> None:
     runs = _ranges("lightbulb.dial")
-    assert runs[:2] == [("to_bulb", 1, 10), ("preshape", 6, 10)]
+    # Fig. 10's approach in two parts: to 10 cm above the bulb while preshaping, then down
+    # onto it, watched; each reaction (thumb, middle) backs off and waits for the thumb.
+    assert runs[:8] == [
+        ("to_bulb", 1, 6),
+        ("preshape", 3, 6),
+        ("settle", 7, 7),
+        ("lower", 8, 11),
+        *[("back_off", 12, 13), ("settle", 14, 14)] * 2,
+    ]
     # Added to the paper's script: feel for the glass along two axes and centre over it,
     # each time once the thumb is at rest (a while loop: shown once, run zero or more times).
-    assert runs[2:10] == [
-        ("settle", 11, 11),
-        ("feel_glass", 12, 12),
-        ("centre_y", 13, 15),
-        ("turn_probe", 16, 21),
-        ("settle", 22, 22),
-        ("feel_glass", 23, 23),
-        ("centre_x", 24, 26),
-        ("turn_back", 27, 32),
+    assert runs[8:16] == [
+        ("settle", 15, 15),
+        ("feel_glass", 16, 16),
+        ("centre_y", 17, 19),
+        ("turn_probe", 20, 25),
+        ("settle", 26, 26),
+        ("feel_glass", 27, 27),
+        ("centre_x", 28, 30),
+        ("turn_back", 31, 36),
     ]
-    first_iteration = [
-        ("grasp_bulb", 33, 33),
-        ("twist_hand", 34, 42),
-        ("twist_armCCW", 34, 42),
-        ("ungrasp", 43, 45),
-        ("preshape", 46, 52),
-        ("twist_armCW", 46, 52),
-    ]
-    # Every repeated iteration is the same 20 ticks, shifted.
-    iterations = (len(runs) - 10 - 4) // 6
-    assert iterations >= 2
-    for i in range(iterations):
-        shifted = [(e, s + 20 * i, h + 20 * i) for e, s, h in first_iteration]
-        assert runs[10 + 6 * i : 16 + 6 * i] == shifted
-    last = 32 + 20 * iterations
-    assert runs[-4:] == [
-        ("grasp_bulb", last + 1, last + 1),
-        ("twist_hand", last + 2, last + 10),
-        ("twist_armCCW", last + 2, last + 10),
-        ("retract_arm", last + 11, last + 20),
+    # One stroke of the loop that ends when the tug comes free (shown once): the paper's
+    # grasp and twist, a hold and the tug; if the bulb held, release, follow it up, turn back.
+    assert runs[16:] == [
+        ("grasp_bulb", 37, 37),
+        ("twist_hand", 38, 46),
+        ("twist_armCCW", 38, 48),
+        ("tug", 49, 49),
+        ("ungrasp", 50, 52),
+        ("follow", 52, 52),
+        ("preshape", 53, 59),
+        ("twist_armCW", 53, 59),
+        ("retract_arm", 60, 69),
     ]
 
 

@@ -22,6 +22,7 @@ from dial.geometry import Pose, location_pose, rpy_matrix
 from dial.parser.script import Script
 from dial.primitives import Context
 from dial.scene.resolve import resolve_scene, worlds_dir
+from dial.scene.thread import set_turns
 from dial.scene.world import World, load_world
 from dial.scheduler.log import EventLog
 
@@ -86,6 +87,7 @@ def prepare(
     """Load the scene, place the robot at home, perturb, settle; log the ``scene`` record."""
     world = script_world(script)
     model = load_model(world.model_path)
+    set_turns(model, world)
     placed = Disturbances.on(model, disturbances)  # an unknown body fails before anything moves
     index = RobotIndex.from_model(model)
     unmoved = mujoco.MjData(model)

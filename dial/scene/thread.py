@@ -5,13 +5,18 @@ A threaded object is a free body welded (equality ``P_thread_weld``) to a carrie
 a constraint off by itself, so the physics driver calls :meth:`Thread.update` after every
 physics step: once the turn reaches the top of its range, the weld is switched off and the
 object is free. Releasing is one-way; ``mj_resetData`` re-engages it (``eq_active0``).
+A world file's ``[thread] turns`` sets how many turns that takes (:func:`set_turns`).
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import mujoco
+
+from dial.scene.reader import WorldFileError
+from dial.scene.world import World
 
 WELD_SUFFIX = "_thread_weld"
 RELEASE_MARGIN = 0.01  # rad below the top of the turn range; MuJoCo's limits are soft
@@ -53,3 +58,25 @@ def find_threads(model: mujoco.MjModel) -> tuple[Thread, ...]:
         top = float(turn.range[1])
         threads.append(Thread(prefix, i, int(turn.qposadr[0]), top - RELEASE_MARGIN))
     return tuple(threads)
+
+
+def set_turns(model: mujoco.MjModel, world: World) -> None:
+    """Apply the world file's ``[thread] turns``: every thread's turn range becomes
+    [0, 2 pi turns], so it lets go after that many turns (screwed tight at 0, as compiled).
+
+    Call it before :func:`find_threads`, which reads the release point from the range.
+    """
+    if world.thread_turns is None:
+        return
+    threads = find_threads(model)
+    if not threads:
+        raise WorldFileError(
+            world.path,
+            "thread",
+            f"the scene's model ({world.model_path.name}) has no screw thread "
+            f"(an equality named P{WELD_SUFFIX})",
+        )
+    for thread in threads:
+        model.jnt_range[model.joint(f"{thread.name}_thread_turn").id, 1] = (
+            2.0 * math.pi * world.thread_turns
+        )

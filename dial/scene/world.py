@@ -25,6 +25,7 @@ from dial.scene.resolve import resolve_scene
 from dial.scene.valii import NAME, Appro, Drive, Move, Statement, StatementError, parse_statement
 
 JOINTS: tuple[str, ...] = ("abd", "mcp", "pip", "dip")  # joint j of a finger: bit 4*f + j
+MAX_TURNS = 20.0  # a thread's turns before it lets go; more is a typo, not a bulb
 AXES: tuple[str, ...] = ("object", "world")
 
 
@@ -90,6 +91,7 @@ class World:
     locations: Mapping[str, Location]
     programs: Mapping[str, Program]
     criteria: tuple[Criterion, ...]
+    thread_turns: float | None = None  # [thread] turns: the model's threads let go after these
 
     def scene_names(self) -> SceneNames:
         """The names the script checker needs."""
@@ -101,7 +103,7 @@ class World:
         )
 
 
-_OPTIONAL_KEYS = ("poses", "locations", "programs", "criteria")
+_OPTIONAL_KEYS = ("poses", "locations", "programs", "criteria", "thread")
 
 
 def load_world(path: Path) -> World:
@@ -145,6 +147,7 @@ def load_world(path: Path) -> World:
         locations=MappingProxyType(locations),
         programs=MappingProxyType(programs),
         criteria=criteria,
+        thread_turns=_thread_turns(reader, data["thread"]) if "thread" in data else None,
     )
 
 
@@ -251,6 +254,18 @@ def _program(reader: Reader, name: str, value: Any, locations: Mapping[str, Loca
     if not statements:
         raise reader.error(key, "a program needs at least one statement")
     return Program(name, tuple(statements))
+
+
+def _thread_turns(reader: Reader, value: Any) -> float:
+    """``[thread] turns``: counter-clockwise turns from screwed tight until the thread lets go."""
+    table = reader.table(value, "thread")
+    reader.keys(table, "thread", ["turns"], [])
+    turns = reader.number(table["turns"], "thread.turns")
+    if not 0.0 < turns <= MAX_TURNS:
+        raise reader.error(
+            "thread.turns", f"expected more than 0 and at most {MAX_TURNS:g}, got {turns:g}"
+        )
+    return turns
 
 
 def _name(reader: Reader, table: str, name: str) -> str:

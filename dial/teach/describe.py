@@ -79,7 +79,10 @@ def criterion_text(criterion: Criterion) -> str:
 
 def describe(world: World, believed: Believed) -> str:
     """Every name of ``world``; ``believed`` maps each object's body to its pose at load."""
-    lines = [f"scene {world.name}: {world.path}", f"model {world.model_path.name}", ""]
+    lines = [f"scene {world.name}: {world.path}", f"model {world.model_path.name}"]
+    if world.thread_turns is not None:
+        lines.append(f"thread {world.thread_turns:g} turns until it lets go")
+    lines.append("")
     lines.append("objects (believed pose at load: pos mm, rpy deg)")
     rows = []
     for alias, body in world.objects.items():

@@ -22,7 +22,7 @@ from dial.backend.snapshot import FloatArray
 from dial.geometry import location_pose, rpy_matrix, smooth
 from dial.primitives.arm import Segment
 from dial.primitives.context import Context
-from dial.scene.thread import find_threads
+from dial.scene.thread import find_threads, set_turns
 from dial.scene.world import World
 from dial.teach.contacts import Parts, collision
 
@@ -82,6 +82,7 @@ class Sim:
     def __init__(self, world: World, settle: bool = True) -> None:
         self.world = world
         self.model = model = load_model(world.model_path)
+        set_turns(model, world)
         self.data = data = mujoco.MjData(model)
         self.index = ix = RobotIndex.from_model(model)
         self.parts = Parts.of(model, ix)

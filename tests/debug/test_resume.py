@@ -41,8 +41,8 @@ def _check_exact(script: str, scene: str | None, block: int, tmp_path: Path) -> 
 @pytest.mark.parametrize(
     ("script", "scene", "block"),
     [
-        ("lightbulb.dial", None, 5),  # a block inside '@repeat 4' (its second iteration)
-        ("lightbulb.dial", None, 8),  # the block after the repeat
+        ("lightbulb.dial", None, 7),  # inside '@repeat until !tug' (its second iteration)
+        ("lightbulb.dial", None, 12),  # the block after that loop
         ("explore_surface.dial", None, 20),  # inside '@repeat until' loops and '@if'
         ("explore.dial", "explore_block", 2),  # the @call of a procedure comes after it
         ("explore.dial", "explore_block", 4),  # inside the called procedure
@@ -55,12 +55,12 @@ def test_resume_is_exact(script: str, scene: str | None, block: int, tmp_path: P
 
 @pytest.fixture(scope="module")
 def saved(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
-    """A copy of lightbulb.dial (and its world) and a state saved before its block 8."""
+    """A copy of lightbulb.dial (and its world) and a state saved before its block 12."""
     folder = tmp_path_factory.mktemp("edits")
     script = folder / "lightbulb.dial"
     shutil.copy(ROOT / "scripts" / "lightbulb.dial", script)
     state = folder / "lb.state"
-    assert main(["run", str(script), "--save-at", "block:8", str(state), "--quiet"]) == 0
+    assert main(["run", str(script), "--save-at", "block:12", str(state), "--quiet"]) == 0
     return script, state
 
 
@@ -70,11 +70,9 @@ def test_resuming_an_edited_later_block_runs_the_edit(
     script, state = saved
     edited = tmp_path / "lightbulb.dial"
     text = script.read_text()
-    # The last block (line 94 on): retract 10 ticks -> a shorter, 6-tick retract.
-    assert "retract_arm            #=========\n" in text
-    edited.write_text(
-        text.replace("retract_arm            #=========\n", "retract_arm            #=====\n")
-    )
+    # The last block (line 150 on): retract 10 ticks -> a shorter, 6-tick retract.
+    assert "retract_arm  #=========\n" in text
+    edited.write_text(text.replace("retract_arm  #=========\n", "retract_arm  #=====\n"))
     before = dial.run(dial.load(script), resume=state)
     after = dial.run(dial.load(edited), resume=state)
     assert after.summary.ticks == before.summary.ticks - 4

@@ -1,55 +1,129 @@
-"""The light-bulb task under perturbation (tests/scenarios runs it at the default tick).
-
-The grasp must make up a bulb that is not where the world model believes: with seed 4 the
-offset is one that made the paper's index-middle-ring grip curl under the glass and jam.
-At 10 mm, seeds 1, 6 and 7 lost the freed bulb from an off-centre pinch until the script
-learnt to feel for the glass and centre over it before grasping.
+"""The light-bulb task: unscrewed stroke by stroke until a tug comes free, with the bulb off
+its believed place and with threads of other lengths; and its reaction to an unexpected
+touch on the way down (docs/scenes.md, "The light-bulb task as tuned" and its disturbance
+envelope). tests/scenarios runs it at the default tick without perturbation.
 """
 
 from __future__ import annotations
 
+import json
+from pathlib import Path
+from typing import Any
+
 import pytest
 
-from dial.engine import RunOptions, run
-from dial.parser import load
-from dial.scene import load_scene_names
+import dial
+from dial.cli import main
 
 from ..conftest import ROOT
 
+SCRIPT = ROOT / "scripts" / "lightbulb.dial"
+# The documented push: the thumb's fingertip pushed 5 N towards the glass for 0.5 s while the
+# hand comes down onto the bulb (lower: 1.5-2.5 s at the default tick).
+PUSH = "push body=hand_thumb_distal force=0,5,0 at=1.6 for=0.5"
+HELD = {"bulb_out": True, "bulb_held": True}
 
-def test_lightbulb_comes_out_held_when_5mm_off() -> None:
-    script = load(ROOT / "scripts" / "lightbulb.dial", loader=load_scene_names)
-    result = run(script, RunOptions(perturb_mm=5.0, seed=4))
-    assert result.summary.ok, result.summary.error
-    assert result.success == {"bulb_out": True, "bulb_held": True}, result.details
-    # The thread lets go during the last twist, as in the paper: no stroke is wasted.
+
+def _ended(result: dial.RunResult, event: str) -> list[dict[str, Any]]:
+    return [r for r in result.log.of("end") if r["event"] == event]
+
+
+def _unscrewed_by_sensing(result: dial.RunResult, exact: bool = True) -> int:
+    """Check the loop ended on a tug that came free after the thread let go (``exact``: in
+    the twist just before it, no stroke wasted); return the number of strokes."""
+    tugs = _ended(result, "tug")
+    assert [r["outcome"] for r in tugs[:-1]] == ["done"] * (len(tugs) - 1)
+    assert tugs[-1]["outcome"] == "missed"  # the bulb came up with the hand
+    assert all(r["data"]["kind"] == "force" for r in tugs[:-1])
     (released,) = result.log.of("thread")
-    last_grasp = result.log.of("start")[-4]
-    assert last_grasp["event"] == "grasp_bulb" and released["t"] > last_grasp["t"]
+    assert released["t"] < tugs[-1]["t"]
+    if exact:
+        assert tugs[-2]["t"] < released["t"]
+    lift = next(r for r in result.log.of("start") if r["event"] == "retract_arm")
+    assert lift["t"] >= tugs[-1]["t"]
+    return len(tugs)
 
 
-@pytest.mark.parametrize("seed", [1, 6, 7])
-def test_lightbulb_centres_on_the_glass_by_touch_when_10mm_off(seed: int) -> None:
-    script = load(ROOT / "scripts" / "lightbulb.dial", loader=load_scene_names)
-    result = run(script, RunOptions(perturb_mm=10.0, seed=seed))
-    assert result.summary.ok, result.summary.error
-    assert result.success == {"bulb_out": True, "bulb_held": True}, result.details
-    # Two touches of the thumb, one per horizontal axis, each stopped by its tendon force.
-    feels = [r for r in result.log.of("end") if r["event"] == "feel_glass"]
+def test_lightbulb_comes_out_held_when_20mm_off() -> None:
+    # Seed 21 puts the bulb 20 mm towards the thumb: the old preshape came down with the thumb
+    # on the glass, and the script waited for it to come to rest until its loop gave up.
+    result = dial.run(SCRIPT, perturb=20, seed=21)
+    assert result.ok, result.error
+    assert result.success == HELD, result.details
+    assert not result.log.of("monitor")  # the way down touched nothing
+    feels = _ended(result, "feel_glass")
     assert [(r["outcome"], r["data"]["kind"], r["data"]["finger"]) for r in feels] == [
         ("done", "force", "thumb")
     ] * 2
-    # The travel to the touch is the believed one (about 20 mm) plus the offset along it.
-    assert all(0.008 < r["data"]["travel"] < 0.032 for r in feels)
+    assert 3 <= _unscrewed_by_sensing(result) <= 5  # 1.5 turns, about 140 degrees a stroke
 
 
-def test_at_a_fast_tick_the_thumb_feels_only_once_at_rest() -> None:
-    # At 0.04 s the fingers still ring from the approach: without waiting for them to rest,
-    # the force guard fired after 1-3 mm, before the glass.
-    script = load(ROOT / "scripts" / "lightbulb.dial", loader=load_scene_names)
-    result = run(script, RunOptions(tick=0.04))
-    assert result.success == {"bulb_out": True, "bulb_held": True}, result.details
-    waits = [r["value"] for r in result.log.of("condition") if r["condition"] == "ringing"]
-    assert waits.count(True) >= 2 and waits[-1] is False  # it waited, then went on
-    feels = [r["data"]["travel"] for r in result.log.of("end") if r["event"] == "feel_glass"]
-    assert feels == [pytest.approx(0.0198, abs=0.001)] * 2
+def test_lightbulb_centres_and_unscrews_at_its_fastest_reliable_tick_when_10mm_off() -> None:
+    # Seed 34: 10 mm along the line of index and ring, across the thumb's first feel. At this
+    # tick the tug just after the thread lets go may still feel the fingers ringing from the
+    # fast twist: a stroke or two more, on the freed bulb (docs/tuning.md).
+    result = dial.run(SCRIPT, tick=0.06, perturb=10, seed=34)
+    assert result.ok and result.success == HELD, (result.error, result.details)
+    assert 3 <= _unscrewed_by_sensing(result, exact=False) <= 6
+
+
+def test_a_longer_thread_takes_more_strokes_and_the_hand_follows_it_up() -> None:
+    result = dial.run(SCRIPT, scene="lightbulb_long", perturb=10, seed=12)
+    assert result.ok and result.success == HELD, (result.error, result.details)
+    assert 8 <= _unscrewed_by_sensing(result) <= 11  # 3.5 turns
+    assert len(_ended(result, "follow")) == len(_ended(result, "tug")) - 1
+
+
+def test_a_world_file_sets_the_turns_of_another_bulb(tmp_path: Path) -> None:
+    bulb = tmp_path / "one_turn.toml"
+    bulb.write_text('extends = "lightbulb"\n\n[thread]\nturns = 1\n')
+    result = dial.run(SCRIPT, scene=str(bulb), perturb=10, seed=3)
+    assert result.ok and result.success == HELD, (result.error, result.details)
+    assert 2 <= _unscrewed_by_sensing(result) <= 3
+
+
+def test_a_push_on_the_way_down_is_met_by_the_reaction(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    log = tmp_path / "run.jsonl"
+    status = main(["run", str(SCRIPT), "--disturb", PUSH, "--log", str(log), "--json", "--quiet"])
+    summary = json.loads(capsys.readouterr().out.splitlines()[-1])
+    assert status == 0 and summary["ok"] is True, summary["error"]
+    records = [json.loads(line) for line in log.read_text().splitlines()]
+    kinds = [(r["kind"], r.get("event") or r.get("what")) for r in records]
+    pushed = kinds.index(("disturb", PUSH))
+    fired = kinds.index(("monitor", "bump_thumb"))
+    assert pushed < fired  # the thumb felt the push on the way down
+    after = [(k, e, r.get("outcome")) for (k, e), r in zip(kinds, records, strict=True)][fired:]
+    assert after[1] == ("end", "lower", "preempted")  # stopped where it was
+    started = [e for k, e, _ in after if k == "start"]
+    assert started[0] == "back_off"  # the reaction's first run
+    again = after.index(("start", "lower", None))
+    assert ("end", "lower", "done") in after[again:]  # the retried descent went down
+    assert summary["success"] == HELD
+
+
+def test_without_its_reaction_the_same_push_leaves_the_thumb_caught(tmp_path: Path) -> None:
+    text = SCRIPT.read_text()
+    first, rest = text.split("bump_thumb   ~~~~\n", 1)
+    rest = rest[rest.index("/* FEEL FOR THE GLASS") :]  # the watches and both @on removed
+    bare = tmp_path / "lightbulb_without_on.dial"
+    bare.write_text(first + "\n" + rest)
+    result = dial.run(dial.load(bare), disturb=[PUSH])
+    assert not result.ok
+    assert result.error is not None and "@repeat while ringing" in result.error
+    assert not result.log.of("monitor")
+
+
+def test_sensor_dropouts_on_the_way_down_cause_no_false_reaction() -> None:
+    # The monitors read tendon-force changes: a tactile or position dropout does not touch
+    # them, and a force dropout reads as no change (the open fingers carry no load).
+    dropouts = [
+        f"sense sensor={kind}:{finger} at=1.5 for=1.0"
+        for kind in ("tactile", "force", "position")
+        for finger in ("thumb", "middle")
+    ]
+    result = dial.run(SCRIPT, disturb=dropouts)
+    assert result.ok and result.success == HELD, (result.error, result.details)
+    assert not result.log.of("monitor")
+    assert len(result.log.of("disturb")) == 2 * len(dropouts)

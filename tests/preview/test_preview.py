@@ -176,10 +176,16 @@ def test_a_monitor_preempts_its_block_and_its_reaction_is_previewed() -> None:
     assert done.counts.reactions == 1 and done.problems.count == 0
 
 
-def test_fingers_that_collide_are_reported() -> None:
-    # lightbulb.toml's unscrew pose abducts the middle finger 15 deg towards the index,
-    # which does not follow: the two overlap (in the run too: they press on each other).
-    result = preview(load("lightbulb.dial"))
+def test_fingers_that_collide_are_reported(tmp_path: Path) -> None:
+    # lightbulb.toml's unscrew pose abducts the middle finger 15 deg towards the index. With
+    # the index curled in, as the bulb's preshape had it before issue 13, the index stays in
+    # the way: the two overlap (in the run too: they pressed on each other). With every
+    # finger bent back straight, as the preshape is now, they pass.
+    assert not preview(load("lightbulb.dial")).problems
+    curled = tmp_path / "curled.toml"
+    fingers = "".join(f"{f} = [0, -15, 20, 20]\n" for f in ("index", "middle", "ring", "thumb"))
+    curled.write_text(f'extends = "lightbulb"\n\n[poses.prelight]\n{fingers}')
+    result = preview(load("lightbulb.dial", scene=str(curled)))
     assert result.problems
     assert all("the index finger and the middle finger collide" in p for p in result.problems)
     assert all(": twist_hand: " in p for p in result.problems)

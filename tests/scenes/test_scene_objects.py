@@ -3,14 +3,16 @@
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import mujoco
 import numpy as np
 import pytest
 
-from dial.scene.thread import find_threads
+from dial.scene import WorldFileError, load_world, worlds_dir
+from dial.scene.thread import find_threads, set_turns
 
-from .conftest import ObjectWorld, step, warnings
+from .conftest import ObjectWorld, step, warnings, write
 
 BALLS = [f"pour_ball_{k:02d}" for k in range(20)]
 PITCH = 0.004  # m per turn
@@ -174,6 +176,31 @@ def test_thread_engages_again_after_reset(object_world: ObjectWorld) -> None:
     assert thread.update(data) and not thread.update(data)
     mujoco.mj_resetData(model, data)
     assert thread.engaged(data)
+
+
+def test_a_world_file_sets_the_turns_before_the_thread_lets_go(
+    object_world: ObjectWorld, tmp_path: Path
+) -> None:
+    model, data = object_world("lightbulb")
+    set_turns(model, load_world(worlds_dir() / "lightbulb_long.toml"))
+    (thread,) = find_threads(model)
+    assert thread.release_turn == pytest.approx(2 * math.pi * 3.5, abs=0.02)
+    half = write(tmp_path / "half.toml", 'extends = "lightbulb"\n[thread]\nturns = 0.5\n')
+    set_turns(model, load_world(half))
+    (thread,) = find_threads(model)
+    bulb = model.body("lightbulb_bulb").id
+    z0 = data.xpos[bulb, 2]
+    assert _twist(model, data, 0.08, 2.0, speed=3.0)  # free after half a turn, 2 mm up
+    assert data.qpos[thread.turn_qpos] / (2 * math.pi) == pytest.approx(0.5, abs=0.03)
+    assert data.xpos[bulb, 2] - z0 == pytest.approx(0.5 * PITCH, abs=3e-4)
+
+
+def test_thread_turns_need_a_model_with_a_thread(object_world: ObjectWorld) -> None:
+    model, _ = object_world("pour")
+    set_turns(model, load_world(worlds_dir() / "pour.toml"))  # no [thread]: nothing to do
+    world = load_world(worlds_dir() / "lightbulb_long.toml")
+    with pytest.raises(WorldFileError, match=r"lightbulb_long.toml: thread: .* no screw thread"):
+        set_turns(model, world)
 
 
 # Resting solids ---------------------------------------------------------------------------

@@ -34,12 +34,13 @@ SCENES = (
     "explore_cylinder",
     "explore_rounded",
     "lightbulb",
+    "lightbulb_long",
     "pour",
     "reactions",
     "surface",
 )
 PAPER_PROGRAMS = {
-    "lightbulb": {"to_bulb", "twist_wrist", "twist_CW", "retract_arm"},
+    "lightbulb": {"to_bulb", "lower_to_bulb", "twist_wrist", "twist_CW", "retract_arm"},
     "pour": {"get_top", "lift_top", "to_grasp", "pour", "retract_arm"},
 }
 PAPER_POSES = {"open_hand", "prelight", "unscrew", "ungrasp", "point", "prepit"}
@@ -64,7 +65,7 @@ def test_load_scene_names_reports_masks_locations_programs() -> None:
     assert names.name == "lightbulb"
     assert names.poses["prelight"] == 0xFFFF
     assert names.poses["unscrew"] == 0x1010  # middle and thumb abduction: the grip is kept
-    assert names.poses["ungrasp"] == 0xEEEE
+    assert names.poses["ungrasp"] == 0xEEEF  # flexion, and the index abducts with the middle
     assert names.poses["point_down"] == 0x000F
     assert "above_bulb" in names.locations
     assert names.programs == PAPER_PROGRAMS["lightbulb"]
@@ -197,6 +198,12 @@ def _world(tmp_path: Path, body: str) -> Path:
             "criteria.c.tilt: unknown key",
         ),
         ("[bogus]", "bogus: unknown key; valid keys: scene, objects, poses"),
+        ("[thread]\nturns = true", "thread.turns: expected a number, got a boolean (true)"),
+        ("[thread]", "thread: missing key 'turns' (keys: turns)"),
+        ("[thread]\nturns = 2\npitch = 4", "thread.pitch: unknown key; valid keys: turns"),
+        ('[thread]\nturns = "2"', "thread.turns: expected a number, got a string ('2')"),
+        ("[thread]\nturns = 0", "thread.turns: expected more than 0 and at most 20, got 0"),
+        ("[thread]\nturns = 25", "thread.turns: expected more than 0 and at most 20, got 25"),
         ("[locations]\n1a = { pos = [0, 0, 0], rpy = [0, 0, 0] }", "locations.1a: invalid name"),
     ],
 )
@@ -207,6 +214,15 @@ def test_errors_name_file_key_and_choices(tmp_path: Path, body: str, message: st
     assert str(e.value).startswith(f"{path}: ")
     assert message in str(e.value)
     assert isinstance(e.value, ValueError)  # the SceneLoader contract
+
+
+def test_thread_turns_are_a_world_setting_that_extends_inherits(tmp_path: Path) -> None:
+    assert load_world(worlds_dir() / "lightbulb.toml").thread_turns == 1.5
+    assert load_world(worlds_dir() / "lightbulb_long.toml").thread_turns == 3.5
+    assert load_world(_world(tmp_path, "")).thread_turns is None  # the model's own range
+    mine = write(tmp_path / "bulb.toml", 'extends = "lightbulb_long"\n[thread]\nturns = 5\n')
+    world = load_world(mine)
+    assert world.thread_turns == 5.0 and world.model_path.name == "scene_lightbulb.xml"
 
 
 def test_toml_syntax_error_names_the_file(tmp_path: Path) -> None:

@@ -206,6 +206,9 @@ def test_world_lists_the_scene(capsys: pytest.CaptureFixture[str]) -> None:
     assert home in out
     assert "  to_grasp     DEPART 80mm; MOVE beside_pitcher; MOVES pitcher_above; MOVES" in out
     assert "  pitcher_upright  upright             object=pour_pitcher max_tilt_deg=10" in out
+    assert "thread" not in out
+    assert main(["world", "lightbulb_long"]) == 0
+    assert "\nthread 3.5 turns until it lets go\n" in capsys.readouterr().out
 
 
 def test_world_picture(tmp_path: Path) -> None:
