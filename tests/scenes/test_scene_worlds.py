@@ -257,7 +257,7 @@ def test_extends_a_bundled_scene_by_name_and_detects_cycles(tmp_path: Path) -> N
     )
     world = load_world(mine)
     assert world.name == "mine" and world.locations["side_135"].body == "containment_rounded"
-    programs = {"to_top", "to_sides", "down_sides", "retract_arm"}
+    programs = {"to_top", "down_top", "to_sides", "down_sides", "retract_arm"}
     programs |= {f"to_top_{side}" for side in ("east", "west", "north", "south")}
     programs |= {f"next_{azimuth}" for azimuth in (225, 270, 315, 0, 45, 90, 135)}
     assert load_scene_names("mine.toml", tmp_path).programs == programs
