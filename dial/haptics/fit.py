@@ -168,13 +168,7 @@ def fit_superquadric(
     if not starts:
         raise ValueError("starts must name at least one (eps1, eps2) pair")
     p = _points(points, SUPERQUADRIC_MIN_POINTS, "a superquadric")
-    # Work in units of the points' rms radius, so sizes, centre and rotation are all ~1.
-    origin = p.mean(axis=0)
-    scale = float(np.sqrt(np.mean(np.sum((p - origin) ** 2, axis=1))))
-    q = (p - origin) / scale
-    _, s, vt = np.linalg.svd(q, full_matrices=False)
-    if s[2] <= RANK_RTOL * s[0]:
-        raise FitError(f"the {len(p)} points span no volume: they are collinear or coplanar")
+    origin, scale, q, vt = _normalised(p)
     along = q @ vt.T
     low, high = along.min(axis=0), along.max(axis=0)
     mid = vt.T @ ((low + high) / 2.0)
@@ -207,6 +201,19 @@ def fit_superquadric(
         cost=cost * scale**3,
         count=len(p),
     )
+
+
+def _normalised(p: Array) -> tuple[Array, float, Array, Array]:
+    """The points' mean, rms radius, the points in units of it about the mean (so sizes,
+    centre and rotation are all ~1), and their principal axes (rows); raises
+    :class:`FitError` for points that span no volume."""
+    origin = p.mean(axis=0)
+    scale = float(np.sqrt(np.mean(np.sum((p - origin) ** 2, axis=1))))
+    q = (p - origin) / scale
+    _, s, vt = np.linalg.svd(q, full_matrices=False)
+    if s[2] <= RANK_RTOL * s[0]:
+        raise FitError(f"the {len(p)} points span no volume: they are collinear or coplanar")
+    return origin, scale, q, vt
 
 
 def _frames(vt: Array, half: Array) -> list[tuple[Array, Array]]:
