@@ -27,22 +27,32 @@ GRAB = '% grab grasp_force "0x0666_0x0222 4N" timeout=2s\n'
 def test_lightbulb_timeline_runs_at_the_compiled_ticks() -> None:
     script = load(ROOT / "scripts" / "lightbulb.dial")
     # Each grasp takes 0.6 s against a 0.25 s tick: its tick stretches by 35 periods. Each
-    # wait for the thumb to rest runs once, as the chart shows it.
-    once = Behaviour(outcomes=(Outcome.DONE, Outcome.MISSED, Outcome.DONE, Outcome.MISSED))
-    behaviours = {"grasp_bulb": Behaviour(duration=0.6), "ringing": once}
+    # wait for the thumb to rest runs once; the first tug holds (threaded), the second comes
+    # free, so the unscrewing loop runs twice and its @if once. No monitor fires.
+    D, M = Outcome.DONE, Outcome.MISSED
+    behaviours = {
+        "grasp_bulb": Behaviour(duration=0.6),
+        "ringing": Behaviour(outcomes=(D, M) * 3),
+        "tug": Behaviour(outcomes=(D, M)),
+    }
     result = run_fake(script, tick=0.25, behaviours=behaviours)
     assert result.summary.ok
-    layout = expand(script)
-    starts = [(r["event"], r["tick"]) for r in result.log.of("start")]
-    assert starts == [(p.run.event, p.start) for p in layout.runs]
-    ends = [(r["event"], r["tick"]) for r in result.log.of("end")]
-    ends = [e for e in ends if e[0] not in script.condition_only]  # sensed by the tests
-    assert sorted(ends) == sorted((p.run.event, p.exec_end) for p in layout.runs)
-    grasp_ticks = [p.start for p in layout.runs if p.run.event == "grasp_bulb"]
+    runs = {(p.run.event, p.run.line): p.run for p in expand(script).runs}
+    block_tick, seen = 0, []
+    for r in result.log.records:  # every run starts and ends at its tick within its block
+        if r["kind"] == "block":
+            block_tick = r["tick"]
+        elif r["kind"] == "start":
+            seen.append(r["event"])
+            assert r["tick"] - block_tick + 1 == runs[(r["event"], r["line"])].start, r
+        elif r["kind"] == "end" and r["event"] not in script.condition_only:
+            assert r["tick"] - block_tick + 1 == runs[(r["event"], r["line"])].exec_end, r
+    assert seen.count("grasp_bulb") == seen.count("tug") == 2 and seen.count("ungrasp") == 1
+    assert "back_off" not in seen and seen[-1] == "retract_arm"
+    grasp_ticks = [r["tick"] for r in result.log.of("start") if r["event"] == "grasp_bulb"]
     assert result.stretches() == dict.fromkeys(grasp_ticks, 35)
-    assert result.summary.ticks == layout.length
-    stretched = len(grasp_ticks) * 0.35
-    assert result.summary.sim_time == pytest.approx(layout.length * 0.25 + stretched)
+    ticks = result.summary.ticks
+    assert result.summary.sim_time == pytest.approx(ticks * 0.25 + len(grasp_ticks) * 0.35)
     assert result.trio_time == pytest.approx(result.summary.sim_time)
 
 

@@ -11,12 +11,14 @@ period. The driver writes no log: it reports what happened, and the runner recor
 from __future__ import annotations
 
 from collections.abc import Iterable
+from dataclasses import replace
 
 import mujoco
 import numpy as np
 
 from dial.backend.disturb import Disturbances
 from dial.backend.guards import Guard, Guards, Readings
+from dial.backend.locate import finger_bodies, link_point, tactile_point
 from dial.backend.model import HAND_JOINTS, IntArray, RobotIndex, hand_ctrl, tendon_differentials
 from dial.backend.safety import Safety
 from dial.backend.snapshot import FloatArray, Snapshot, Trip, frozen
@@ -71,6 +73,7 @@ class MujocoRobot:
         # writing a slice costs a fraction of writing through an index array.
         self._arm_ctrl = as_slice(ix.arm_actuators)
         self._tendon_ctrl = as_slice(ix.tendon_actuators)
+        self._finger_bodies = tuple(finger_bodies(model, f) for f in range(len(FINGERS)))
         hand_joints = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, n) for n in HAND_JOINTS]
         self.hand_range = model.jnt_range[hand_joints].copy()  # (16, 2) rad, mask order
         self.hand_range.flags.writeable = False
@@ -241,7 +244,7 @@ class MujocoRobot:
                 self._fired.append(Fired(key, trip.time, trip.step))
                 self.monitors.discard(key)
                 continue
-            self._trips[key] = trip
+            self._trips[key] = trip = self._located(trip)
             self._freeze(guard.effector)
             self._happened.append(
                 Happening(
@@ -256,6 +259,17 @@ class MujocoRobot:
                     },
                 )
             )
+
+    def _located(self, trip: Trip) -> Trip:
+        """``trip`` with where its finger touches at this physics step (a dropped-out tactile
+        array locates nothing; see :mod:`dial.backend.locate`)."""
+        f = trip.finger
+        tactile = None
+        if ("tactile", f) not in self.disturbances.dropped:
+            a = self._tactile_adr[f]
+            tactile = tactile_point(self.data.sensordata[a : a + 256], self.taxel_points(f))
+        link = link_point(self.model, self.data, self._finger_bodies[f])
+        return replace(trip, tactile=tactile, link=link)
 
     def _freeze(self, effector: str) -> None:
         """Hold the guarded effector where it is, at this physics step."""

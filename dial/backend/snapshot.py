@@ -14,13 +14,19 @@ FloatArray = NDArray[np.float64]
 
 @dataclass(frozen=True)
 class Trip:
-    """A guard that fired: when (simulated s, physics step), on what, and the reading."""
+    """A guard that fired: when (simulated s, physics step), on what, and the reading.
+
+    ``tactile`` and ``link``: where the finger touched at that physics step (world m, see
+    :mod:`dial.backend.locate`), or None when its array (or its links) touched nothing.
+    """
 
     time: float
     step: int
     kind: str  # tactile, force or position
     finger: int
     value: float
+    tactile: FloatArray | None = None
+    link: FloatArray | None = None
 
 
 class Sensors(Protocol):

@@ -7,6 +7,7 @@ from pathlib import Path
 
 from dial import api
 from dial.cli.common import UsageError, at_least, scene_argument
+from dial.disturb import parse_disturbance
 from dial.instructions.scene_names import SceneNotFoundError
 
 
@@ -15,7 +16,8 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         "tune",
         help="run a script over a grid of tick lengths and find the fastest reliable one",
         description="Run the script K times at each of N tick lengths from A to B, in "
-        "parallel worker processes, and print success rate and task time per tick length. "
+        "parallel worker processes or as Ray tasks, and print success rate and task time "
+        "per tick length. "
         "Exit 0 when some tick length succeeded in every trial, 1 when none did (or the "
         "plot could not be written), 2 on a usage error. See docs/tuning.md.",
     )
@@ -36,7 +38,33 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         help="displace the objects by MM in a direction seeded per trial",
     )
     p.add_argument("--seed", type=int, default=0, metavar="S", help="seed of the trial seeds")
-    p.add_argument("--jobs", type=int, metavar="J", help="worker processes (default: all cores)")
+    p.add_argument(
+        "--disturb",
+        action="append",
+        default=[],
+        metavar="SPEC",
+        help="a deliberate fault in every trial, repeatable, as for dial run: 'push body=NAME "
+        "force=FX,FY,FZ at=T for=D' or 'sense sensor=KIND:FINGER at=T [for=D]'",
+    )
+    p.add_argument(
+        "--jobs",
+        type=int,
+        metavar="J",
+        help="worker processes, or the CPUs of a local Ray (default: all cores)",
+    )
+    p.add_argument(
+        "--executor",
+        choices=("process", "ray"),
+        default="process",
+        help="run the trials in local worker processes (default) or as Ray tasks, "
+        "needs pip install 'dial[ray]'",
+    )
+    p.add_argument(
+        "--address",
+        metavar="ADDR",
+        help="with --executor ray: the Ray cluster, HOST:PORT or auto (default: "
+        "RAY_ADDRESS, else a local Ray started for the sweep)",
+    )
     p.add_argument("--plot", metavar="FILE.png", help="plot success rate and task time")
     p.add_argument("--json", action="store_true", help="print the table as JSON, last line")
     p.set_defaults(func=cmd_tune)
@@ -44,7 +72,7 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
 
 def cmd_tune(args: argparse.Namespace) -> int:
     from dial.scene.resolve import scene_option
-    from dial.tune import ProcessExecutor, TuneOptions, parse_ticks, tune
+    from dial.tune import ProcessExecutor, TuneOptions, models, parse_ticks, tune
 
     try:
         ticks = parse_ticks(args.ticks)
@@ -53,6 +81,8 @@ def cmd_tune(args: argparse.Namespace) -> int:
     at_least("--trials", args.trials, 1)
     at_least("--jobs", args.jobs, 1)
     api.check_options(None, 1.0, args.seed, args.perturb)
+    for spec in args.disturb:  # a bad SPEC is a usage error before anything runs
+        parse_disturbance(spec)
     try:
         scene = None if args.scene is None else scene_option(args.scene)
     except SceneNotFoundError as e:
@@ -66,5 +96,18 @@ def cmd_tune(args: argparse.Namespace) -> int:
         seed=args.seed,
         plot=Path(args.plot) if args.plot else None,
         json=args.json,
+        disturb=tuple(args.disturb),
     )
-    return tune(options, ProcessExecutor(args.jobs))
+    # Each worker compiles a model file once and gives each trial a copy (dial.tune.models).
+    if args.executor == "process":
+        if args.address is not None:
+            raise UsageError("--address needs --executor ray")
+        # spawn: a fork server (preload=models.PRELOAD) measured no faster for one pool
+        return tune(options, ProcessExecutor(args.jobs, initializer=models.install))
+    from dial.tune.ray_executor import RayExecutor, RayUsageError
+
+    try:
+        executor = RayExecutor(args.address, args.jobs, initializer=models.install)
+    except RayUsageError as e:
+        raise UsageError(str(e)) from None
+    return tune(options, executor)

@@ -7,7 +7,6 @@ the true ones, so that only sensing can make up the difference (DESIGN 5).
 from __future__ import annotations
 
 from collections.abc import Sequence
-from pathlib import Path
 
 import mujoco
 import numpy as np
@@ -17,30 +16,19 @@ from dial.backend.driver import MujocoRobot
 from dial.backend.ik import ArmIK
 from dial.backend.model import ARM_HOME, RobotIndex, hand_ctrl, load_model
 from dial.disturb import Disturbance
-from dial.errors import DialError
 from dial.geometry import Pose, location_pose, rpy_matrix
 from dial.parser.script import Script
 from dial.primitives import Context
-from dial.scene.resolve import resolve_scene, worlds_dir
+from dial.scene.of_script import script_world
+from dial.scene.resolve import worlds_dir
 from dial.scene.thread import set_turns
-from dial.scene.world import World, load_world
+from dial.scene.world import World
 from dial.scheduler.log import EventLog
 
 SETTLE_S = 0.5  # objects settle on the table before the script starts
 # Where the tool starts when the world file has no "home" location: high above the tables,
 # pointing down (world m; rpy as in world files).
 START = ((0.40, 0.0, 0.80), (np.pi, 0.0, 0.0))
-
-
-def script_world(script: Script) -> World:
-    """The world the script runs in: ``--scene``, else its ``@scene``."""
-    scene = script.program.scene
-    text = script.scene_override or (scene.text if scene is not None else None)
-    if text is None:
-        raise DialError(
-            f"{script.path}: the script names no scene; add '@scene NAME' or run it with --scene"
-        )
-    return load_world(resolve_scene(text, Path(script.path).resolve().parent))
 
 
 def scene_bodies(model: mujoco.MjModel, world: World) -> list[int]:

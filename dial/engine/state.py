@@ -27,6 +27,7 @@ from dial.backend.driver import MujocoRobot
 from dial.errors import DialError
 from dial.parser.script import Script, Step, TBlock, TCall, TIf, TRepeat
 from dial.primitives import Context
+from dial.primitives.context import StopContact
 from dial.scheduler.position import Frame, Resume
 from dial.scheduler.position import Path as TimelinePath
 from dial.scheduler.ticks import TickLoop
@@ -72,6 +73,15 @@ def _floats(text: str, n: int | None, what: str) -> np.ndarray:
     if n is not None and values.size != n:
         raise ValueError(f"{what} has {values.size} numbers, not {n}")
     return values.astype(np.float64)
+
+
+def _point(point: np.ndarray | None) -> str | None:
+    """A stop's contact point, exact (base64 of the float64s), or None."""
+    return None if point is None else _array(point)
+
+
+def _stop_point(text: str | None) -> np.ndarray | None:
+    return None if text is None else _floats(text, 3, "a stop's contact point")
 
 
 def _digest(line: str) -> str:
@@ -145,6 +155,7 @@ def save(
         "latest": [[s, e, o.value] for (s, e), o in loop.latest.items()],
         "counts": dict(loop.counts),
         "contacts": ctx.point_sets,
+        "stops": {str(f): [_point(c.tactile), _point(c.link)] for f, c in ctx.stops.items()},
         "results": ctx.results,
         "believed": {body: _array(pos) for body, (pos, _) in ctx.believed.items()},
         "robot": {
@@ -245,6 +256,8 @@ class Saved:
         robot.safety.saturation_logged[:] = np.array(r["saturation_logged"], dtype=bool)
         robot.disturbances.resume_at(robot.steps)
         ctx.point_sets.update(d["contacts"])
+        for f, (tactile, link) in d.get("stops", {}).items():
+            ctx.stops[int(f)] = StopContact(_stop_point(tactile), _stop_point(link))
         ctx.results.update(d["results"])
         for body, pos in d.get("believed", {}).items():  # as `locate` left them
             if body in ctx.believed:

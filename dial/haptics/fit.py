@@ -23,12 +23,21 @@ RANK_RTOL = 1e-9  # s_k below this fraction of s0 is zero: exact collinearity or
 SPREAD_RATIO = 3.0  # a plane needs s1 (spread along the 2nd axis) well above s2 (the scatter)
 
 PLANE_MIN_POINTS = 3
-SHAPE_BOUNDS = (0.1, 2.0)  # eps1, eps2; below 0.1 the exponents 2/eps make F ill-conditioned
+# eps1, eps2. At 0.03 a flat side's edge is rounded off by about 1 % of the size (at 0.1 it was
+# 3 %, and a fit to contacts on the edges grew 5-10 % too large); below it the exponents 2/eps
+# make F too steep to optimise reliably.
+SHAPE_BOUNDS = (0.03, 2.0)
 SUPERQUADRIC_MIN_POINTS = 11  # one per parameter: 3 sizes, 2 shapes, 3 translation, 3 rotation
 # Starting exponents (eps1, eps2): square-edged and ellipsoidal. Each is tried with each
 # principal axis as the superquadric's z axis, because a cylinder fits only along its own axis.
 DEFAULT_STARTS: tuple[tuple[float, float], ...] = ((0.3, 0.3), (1.0, 1.0))
 TIE_RTOL = 1e-6  # costs this close (relative) are the same fit
+# Soft-L1 loss: a residual above this (in units of the points' rms radius, about 0.1 mm off
+# the surface on a hand-sized solid) counts in proportion to its size, not its square, so that
+# a few contacts off the model (on a sharp edge, which no superquadric reaches exactly, or a
+# stray contact) pull the fit less.
+LOSS_SCALE = 0.003
+MAX_EVALUATIONS = 600  # per start: good starts converge in 20-300, poor ones crawl on
 
 
 class FitError(ValueError):
@@ -74,8 +83,8 @@ class SuperquadricFit:
     the superquadric's x, y, z axes in the world frame, with a1 >= a2 and z in the upper
     hemisphere (world z >= 0). ``shape`` (2,) is (eps1, eps2): eps1 shapes the profile along
     z, eps2 the cross-section in x-y. ``centre`` (3,) is in the world frame. ``rms_residual``
-    is the rms radial distance of the points off the surface (m); ``cost`` is the final
-    value of Solina's objective (m^3, see :func:`fit_superquadric`).
+    is the rms radial distance of the points off the surface (m); ``cost`` is half the sum of
+    the squared residuals of Solina's objective at the fit (m^3, see :func:`fit_superquadric`).
     """
 
     size: Array
@@ -143,27 +152,23 @@ def fit_superquadric(
     In the superquadric's frame the inside-outside function is
     ``F = ((x/a1)^(2/e2) + (y/a2)^(2/e2))^(e2/e1) + (z/a3)^(2/e1)``: F = 1 on the surface,
     F < 1 inside. ``scipy.optimize.least_squares`` (trust region reflective, bounded)
-    minimises ``sum (sqrt(a1 a2 a3) (F^e1 - 1))^2`` over the half-sizes a1..a3 > 0, the
-    exponents e1, e2 in ``SHAPE_BOUNDS``, the centre and a rotation vector. ``F^e1 - 1`` is
+    minimises the residuals ``sqrt(a1 a2 a3) (F^e1 - 1)`` over the half-sizes a1..a3 > 0, the
+    exponents e1, e2 in ``SHAPE_BOUNDS``, the centre and a rotation vector, with a soft-L1
+    loss (``LOSS_SCALE``): the larger residuals count by size, not by square. ``F^e1 - 1`` is
     about twice a point's relative radial distance off the surface; the volume factor makes
     the smallest superquadric that fits win, which closes sides the points do not reach (the
     bottom of an object standing on a table) at the outermost contacts.
 
     Each start in ``starts`` (eps1, eps2) is tried with each principal axis of the points as
-    z, from the centre and half-ranges of their principal-axis bounding box; the fit with the
-    lowest cost wins. Raises :class:`FitError` for fewer than 11 points (one per parameter),
-    non-finite values, or points that span no volume (collinear or coplanar).
+    z, from the centre and half-ranges of their principal-axis bounding box, and again with
+    the frame turned 45 deg about z; the fit with the lowest objective wins. Raises
+    :class:`FitError` for fewer than 11 points (one per parameter), non-finite values, or
+    points that span no volume (collinear or coplanar).
     """
     if not starts:
         raise ValueError("starts must name at least one (eps1, eps2) pair")
     p = _points(points, SUPERQUADRIC_MIN_POINTS, "a superquadric")
-    # Work in units of the points' rms radius, so sizes, centre and rotation are all ~1.
-    origin = p.mean(axis=0)
-    scale = float(np.sqrt(np.mean(np.sum((p - origin) ** 2, axis=1))))
-    q = (p - origin) / scale
-    _, s, vt = np.linalg.svd(q, full_matrices=False)
-    if s[2] <= RANK_RTOL * s[0]:
-        raise FitError(f"the {len(p)} points span no volume: they are collinear or coplanar")
+    origin, scale, q, vt = _normalised(p)
     along = q @ vt.T
     low, high = along.min(axis=0), along.max(axis=0)
     mid = vt.T @ ((low + high) / 2.0)
@@ -172,21 +177,17 @@ def fit_superquadric(
     # side no point constrains from running away.
     size_bounds = (np.full(3, 1e-3), np.full(3, 2.0 * float(np.max(high - low))))
 
-    best: tuple[float, Array, Array] | None = None
-    for z_axis in (2, 1, 0):
-        x_axis, y_axis = (i for i in (0, 1, 2) if i != z_axis)
-        frame = np.stack([vt[x_axis], vt[y_axis], vt[z_axis]], axis=1)
-        if np.linalg.det(frame) < 0.0:
-            frame[:, 0] = -frame[:, 0]
-        sizes = half[[x_axis, y_axis, z_axis]]
+    best: tuple[float, float, Array, Array] | None = None
+    for frame, sizes in _frames(vt, half):
         for start in starts:
-            cost, x = _solve(q, frame, np.concatenate([sizes, start, mid]), size_bounds)
+            x0 = np.concatenate([sizes, start, mid, np.zeros(3)])
+            robust, cost, x = _solve(q, frame, x0, size_bounds)
             # Boxes and ellipsoids fit equally well with any axis as z: a near-tie keeps the
             # earlier start, so that rounding does not decide which axis is reported as z.
-            if best is None or cost < best[0] * (1.0 - TIE_RTOL):
-                best = (cost, x, frame)
+            if best is None or robust < best[0] * (1.0 - TIE_RTOL):
+                best = (robust, cost, x, frame)
     assert best is not None
-    cost, x, frame = best
+    _, cost, x, frame = best
     size, shape, centre = x[0:3], x[3:5], x[5:8]
     rotation = frame @ Rotation.from_rotvec(x[8:11]).as_matrix()
     size, rotation = _canonical(size, rotation)
@@ -202,12 +203,44 @@ def fit_superquadric(
     )
 
 
+def _normalised(p: Array) -> tuple[Array, float, Array, Array]:
+    """The points' mean, rms radius, the points in units of it about the mean (so sizes,
+    centre and rotation are all ~1), and their principal axes (rows); raises
+    :class:`FitError` for points that span no volume."""
+    origin = p.mean(axis=0)
+    scale = float(np.sqrt(np.mean(np.sum((p - origin) ** 2, axis=1))))
+    q = (p - origin) / scale
+    _, s, vt = np.linalg.svd(q, full_matrices=False)
+    if s[2] <= RANK_RTOL * s[0]:
+        raise FitError(f"the {len(p)} points span no volume: they are collinear or coplanar")
+    return origin, scale, q, vt
+
+
+def _frames(vt: Array, half: Array) -> list[tuple[Array, Array]]:
+    """Start frames and half-sizes: each principal axis (rows of ``vt``) as z, and each also
+    turned by 45 deg about z. The principal axes of a near-square cross-section lie anywhere
+    in its plane, and a fit started 25 deg or more off a box's faces can end in a pinched
+    shape; one of the two starts is within 22.5 deg of the faces."""
+    c = s = np.sqrt(0.5)
+    twist = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+    frames = []
+    for z_axis in (2, 1, 0):
+        x_axis, y_axis = (i for i in (0, 1, 2) if i != z_axis)
+        frame = np.stack([vt[x_axis], vt[y_axis], vt[z_axis]], axis=1)
+        if np.linalg.det(frame) < 0.0:
+            frame[:, 0] = -frame[:, 0]
+        sizes = half[[x_axis, y_axis, z_axis]]
+        across = float(np.hypot(sizes[0], sizes[1]) * c)
+        frames += [(frame, sizes), (frame @ twist, np.array([across, across, sizes[2]]))]
+    return frames
+
+
 def _solve(
-    q: Array, frame: Array, start: Array, size_bounds: tuple[Array, Array]
-) -> tuple[float, Array]:
-    """One bounded least-squares run from ``start`` (sizes, shapes, centre); rotation starts
-    at ``frame``. Returns the cost (half the sum of squared residuals) and the parameters."""
-    x0 = np.concatenate([start, np.zeros(3)])
+    q: Array, frame: Array, x0: Array, size_bounds: tuple[Array, Array]
+) -> tuple[float, float, Array]:
+    """One bounded robust least-squares run from ``x0`` (sizes, shapes, centre, rotation
+    vector relative to ``frame``). Returns the robust objective, the plain cost (half the sum
+    of squared residuals) and the parameters."""
     lower = np.concatenate([size_bounds[0], np.full(2, SHAPE_BOUNDS[0]), np.full(6, -np.inf)])
     upper = np.concatenate([size_bounds[1], np.full(2, SHAPE_BOUNDS[1]), np.full(6, np.inf)])
     x0 = np.clip(x0, lower, upper)
@@ -219,8 +252,17 @@ def _solve(
         inside_outside = np.exp(shape[0] * _log_f(local, size, shape))  # F^e1
         return np.asarray(np.sqrt(np.prod(size)) * (inside_outside - 1.0))
 
-    done = least_squares(residuals, x0, bounds=(lower, upper), x_scale="jac", max_nfev=2000)
-    return float(done.cost), np.asarray(done.x, dtype=float)
+    done = least_squares(
+        residuals,
+        x0,
+        bounds=(lower, upper),
+        x_scale="jac",
+        loss="soft_l1",
+        f_scale=LOSS_SCALE,
+        max_nfev=MAX_EVALUATIONS,
+    )
+    cost = 0.5 * float(np.sum(done.fun**2))
+    return float(done.cost), cost, np.asarray(done.x, dtype=float)
 
 
 def _log_f(local: Array, size: Array, shape: Array) -> Array:

@@ -321,10 +321,25 @@ INSTRUCTIONS: dict[str, Instruction] = {
         Instruction(
             "record_contact",
             "zero",
-            (_FINGER, ParamSpec("into", Name("set"), "contacts", doc="point set to append to")),
+            (
+                _FINGER,
+                ParamSpec("into", Name("set"), "contacts", doc="point set to append to"),
+                ParamSpec(
+                    "at",
+                    Choice(("now", "stop")),
+                    "now",
+                    doc="now, or where the latest guarded move sensing the finger stopped",
+                ),
+                ParamSpec(
+                    "source",
+                    Choice(("tactile", "links")),
+                    "tactile",
+                    doc="the taxel centroid, or the contact point of the finger's links",
+                ),
+            ),
             _none,
-            "record_contact finger=F [into=SET]",
-            "Append the finger's tactile contact point (world frame) to a point set.",
+            "record_contact finger=F [into=SET] [at=now|stop] [source=tactile|links]",
+            "Append where the finger touches (world frame) to a point set.",
             sensing=True,
             primitive="RecordContact",
         ),

@@ -7,10 +7,23 @@ from dataclasses import dataclass, field
 from dial.backend.driver import MujocoRobot
 from dial.backend.ik import ArmIK, FingerIK
 from dial.backend.slots import Slots
-from dial.backend.snapshot import Snapshot
+from dial.backend.snapshot import FloatArray, Snapshot
 from dial.geometry import Pose, location_pose
 from dial.scene.world import World
 from dial.scheduler.types import Ended, Outcome, Primitive, RunInfo
+
+
+@dataclass(frozen=True)
+class StopContact:
+    """Where a finger touched when a guarded move stopped on its contact (world m).
+
+    ``tactile``: the taxel centroid, None when the array felt nothing (the contact was on
+    the cap or a phalanx); ``link``: the contact point of the finger's links, None when they
+    touched nothing outside the robot. See :mod:`dial.backend.locate`.
+    """
+
+    tactile: FloatArray | None
+    link: FloatArray | None
 
 
 @dataclass
@@ -28,6 +41,8 @@ class Context:
     arm_ik: ArmIK = field(default_factory=ArmIK)
     finger_ik: FingerIK = field(default_factory=FingerIK)
     point_sets: dict[str, list[list[float]]] = field(default_factory=dict)
+    # finger -> where it touched when the latest guarded move sensing it stopped on contact
+    stops: dict[int, StopContact] = field(default_factory=dict)
     results: dict[str, dict[str, object]] = field(default_factory=dict)
 
     def location(self, name: str) -> Pose:

@@ -7,7 +7,8 @@ where the contact is first sensed; the run then ends ``done`` with the contact,
 or ``missed`` when it reaches ``max`` travel without one. With ``press`` the
 effector is then set that much further on from where it stopped, so that a
 light contact holds for the sensing that follows instead of fading as the
-servo settles.
+servo settles. Where the finger touched at the physics step of the stop is kept
+for ``record_contact at=stop``: a light contact may fade within tens of ms.
 """
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ import numpy as np
 
 from dial.backend.snapshot import FloatArray, Snapshot
 from dial.instructions.types import FINGERS
-from dial.primitives.context import Context, RobotPrimitive, done, missed
+from dial.primitives.context import Context, RobotPrimitive, StopContact, done, missed
 from dial.scheduler.types import Ended, Now, RunInfo
 
 
@@ -54,11 +55,14 @@ class GuardedMove(RobotPrimitive):
             self.p0 = self.ctx.finger_ik.tip(self.arm_q, self.hand, self.finger)
         effector = "arm" if self.finger is None else FINGERS[self.finger]
         self.guard = self.slots.guard(effector, self.until, self.sense)
+        for f in self.sense:  # a stop recorded before this move is not this move's contact
+            self.ctx.stops.pop(f, None)
 
     def step(self, snapshot: Snapshot, now: Now) -> Ended | None:
         trip = snapshot.trips.get(self.guard)
         travel = min(self.speed * (now.elapsed - self.info.period), self.length)
         if trip is not None:
+            self.ctx.stops[trip.finger] = StopContact(trip.tactile, trip.link)
             if self.press > 0.0:  # the driver froze the effector at contact: lean in a little
                 if self.finger is None:
                     pos = self.ctx.arm_ik.fk(snapshot.arm_q)[0]

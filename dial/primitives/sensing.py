@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from dial.backend.contact import contact_reading
+from dial.backend.locate import finger_bodies, link_point, tactile_point
 from dial.backend.snapshot import FloatArray, Snapshot
 from dial.haptics import FitError, fit_plane, fit_superquadric
 from dial.instructions.catalogue import contact_condition
@@ -73,7 +74,12 @@ class ContactWait(RobotPrimitive):
 
 
 class RecordContact:
-    """``record_contact finger=F [into=SET]``: the depth-weighted taxel centroid, world frame."""
+    """``record_contact finger=F [into=SET] [at=now|stop] [source=tactile|links]``.
+
+    Appends where the finger touches (world m) to a point set: the depth-weighted taxel
+    centroid (``source=tactile``) or the contact point of its links (``source=links``), now
+    or as it was when the latest guarded move sensing this finger stopped (``at=stop``).
+    """
 
     def __init__(self, ctx: Context, info: RunInfo) -> None:
         self.ctx = ctx
@@ -81,15 +87,31 @@ class RecordContact:
         assert isinstance(finger, int)
         self.finger = finger
         self.set = str(info.event.args["into"])
+        self.at = str(info.event.args["at"])
+        self.source = str(info.event.args["source"])
 
     def sense(self, snapshot: Snapshot) -> Ended:
-        depth = snapshot.tactile[self.finger].reshape(-1)
-        if depth.max() <= 0.0:
-            return missed(f"the {FINGERS[self.finger]} fingertip touches nothing")
-        points = self.ctx.robot.taxel_points(self.finger)
-        point = (depth @ points) / depth.sum()
-        self.ctx.point_sets.setdefault(self.set, []).append([float(x) for x in point])
-        return done(point=point, set=self.set, count=len(self.ctx.point_sets[self.set]))
+        name = FINGERS[self.finger]
+        if self.at == "stop":
+            stop = self.ctx.stops.get(self.finger)
+            if stop is None:
+                return missed(f"no guarded move stopped on a contact of the {name}")
+            point = stop.tactile if self.source == "tactile" else stop.link
+        else:
+            point = self._now(snapshot)
+        if point is None:
+            where = "fingertip array" if self.source == "tactile" else "links"
+            when = "at the stop" if self.at == "stop" else "now"
+            return missed(f"the {name} {where} touched nothing {when}")
+        points = self.ctx.point_sets.setdefault(self.set, [])
+        points.append([float(x) for x in point])
+        return done(point=point, set=self.set, count=len(points))
+
+    def _now(self, snapshot: Snapshot) -> FloatArray | None:
+        robot = self.ctx.robot
+        if self.source == "tactile":  # a dropped-out array reads 0 in the snapshot
+            return tactile_point(snapshot.tactile[self.finger], robot.taxel_points(self.finger))
+        return link_point(robot.model, robot.data, finger_bodies(robot.model, self.finger))
 
 
 class Locate:

@@ -189,9 +189,9 @@ class TickLoop(Generic[S]):
         self.counts["runs"] += 1
         self.records.start(script.path, run, self.tick, self.sim_time)
         if plan.info.event.instruction.length == "zero":
-            self._sense(script, run, cast(Sensor[S], prim))
+            self._sense(script, run, cast("Sensor[S]", prim))
             return
-        prim_s = cast(Primitive[S], prim)
+        prim_s = cast("Primitive[S]", prim)  # quoted: Primitive[S] at run time costs 0.3 us
         active = ActiveRun(script, plan, prim_s, self.tick, self.periods, self.clock)
         self.active.append(active)  # from here on, its stop runs whatever happens
         try:
@@ -202,7 +202,7 @@ class TickLoop(Generic[S]):
     def sense(self, script: Script, run: Run) -> None:
         """Sense a condition-only event now, with zero duration (no start record)."""
         info = RunInfo(script.events[run.event], run, script.path, self.n, self.period, True)
-        sensor = cast(Sensor[S], self.factory(info))
+        sensor = cast("Sensor[S]", self.factory(info))
         self._sense(script, run, sensor)
 
     def _sense(self, script: Script, run: Run, sensor: Sensor[S]) -> None:

@@ -2,14 +2,16 @@
 
 The layers: :mod:`~dial.tune.grid` plans the trials, :mod:`~dial.tune.trial`
 runs one on a backend (the engine, or a fake robot in tests),
-:mod:`~dial.tune.executor` maps them over worker processes (the seam for a
-distributed executor), and :mod:`~dial.tune.report` turns the results into the
-table, the verdict and the JSON object.
+:mod:`~dial.tune.executor` maps them over worker processes and
+:mod:`~dial.tune.ray_executor` over Ray tasks (:mod:`~dial.tune.models` keeps a
+worker's compiled models), and :mod:`~dial.tune.report` turns the results into
+the table, the verdict and the JSON object.
 """
 
 from dial.tune.command import TuneOptions, tune
-from dial.tune.executor import Executor, ProcessExecutor, Progress, SerialExecutor
+from dial.tune.executor import WORKER_DIED, Executor, ProcessExecutor, Progress, SerialExecutor
 from dial.tune.grid import Trial, parse_ticks, plan, trial_seed
+from dial.tune.ray_executor import RayExecutor
 from dial.tune.report import TickRow, fastest_reliable, render_table, summarise, to_json, verdict
 from dial.tune.trial import (
     Backend,
@@ -22,10 +24,12 @@ from dial.tune.trial import (
 )
 
 __all__ = [
+    "WORKER_DIED",
     "Backend",
     "Executor",
     "ProcessExecutor",
     "Progress",
+    "RayExecutor",
     "RunReport",
     "SerialExecutor",
     "TickRow",

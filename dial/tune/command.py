@@ -12,12 +12,14 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TextIO
 
+from dial.disturb import parse_disturbance
 from dial.parser.check import load
 from dial.resources import resolve_script
 from dial.scene import load_scene_names
-from dial.tune.executor import Executor, ProcessExecutor, Progress
-from dial.tune.grid import plan
-from dial.tune.report import fastest_reliable, render_table, summarise, to_json, verdict
+from dial.scene.of_script import check_pushes, script_world
+from dial.tune.executor import Executor, Progress
+from dial.tune.grid import Trial, plan
+from dial.tune.report import TickRow, fastest_reliable, render_table, summarise, to_json, verdict
 from dial.tune.trial import Backend, engine_backend, sweep
 
 
@@ -31,6 +33,7 @@ class TuneOptions:
     plot: Path | None = None
     json: bool = False
     scene: str | None = None  # dial run --scene: an absolute path or a bundled name
+    disturb: tuple[str, ...] = ()  # dial run --disturb SPECs, checked by tune()
 
 
 @contextmanager
@@ -56,8 +59,51 @@ def tune(
     """Run the sweep and report it: 0 if some tick length always succeeded, else 1."""
     out, err = out or sys.stdout, err or sys.stderr  # looked up now: tests replace them
     path = resolve_script(options.script)
-    load(path, loader=load_scene_names, scene=options.scene)  # an error never starts a sweep
-    trials = plan(
+    trials = _plan(path, options)
+    start = time.perf_counter()
+    with _progress_bar(len(trials), err) as progress:
+        results = sweep(trials, executor, backend, progress)
+    wall = time.perf_counter() - start
+    where = getattr(executor, "where", "")  # e.g. "on 2 worker processes"
+    print(f"dial: {len(trials)} trials in {wall:.1f} s wall {where}".rstrip(), file=err)
+    if options.trials > 1 and options.perturb_mm == 0:
+        print("dial: without --perturb, the trials at each tick are the same run", file=err)
+
+    rows = summarise(results)
+    scene = f" in scene {Path(options.scene).stem}" if options.scene else ""
+    faults = f", {len(options.disturb)} disturbance(s)" if options.disturb else ""
+    title = (
+        f"{path}{scene}: {options.trials} trial{'s' if options.trials != 1 else ''} per tick, "
+        f"perturb {options.perturb_mm:g} mm, seed {options.seed}{faults}"
+    )
+    width = shutil.get_terminal_size().columns if out.isatty() else 120
+    out.write(render_table(rows, title, width))
+    for line in verdict(rows):
+        print(line, file=out)
+    status = 0 if fastest_reliable(rows) is not None else 1
+    if options.plot is not None and not _plot(rows, options.plot, title, out, err):
+        status = 1
+    if options.json:
+        meta: dict[str, object] = {
+            "script": str(path),
+            "scene": options.scene,
+            "trials": options.trials,
+            "perturb_mm": options.perturb_mm,
+            "seed": options.seed,
+        }
+        if options.disturb:  # absent otherwise: a sweep without faults prints what it did
+            meta["disturb"] = list(options.disturb)
+        print(json.dumps(to_json(rows, **meta)), file=out)
+    return status
+
+
+def _plan(path: Path, options: TuneOptions) -> list[Trial]:
+    """Check the script and the options as ``dial run`` would, then list the trials: an
+    error never starts a sweep."""
+    script = load(path, loader=load_scene_names, scene=options.scene)
+    if options.disturb:
+        check_pushes([parse_disturbance(d) for d in options.disturb], script_world(script))
+    return plan(
         str(path.resolve()),
         str(path),
         options.ticks,
@@ -65,52 +111,22 @@ def tune(
         options.seed,
         options.perturb_mm,
         options.scene,
+        options.disturb,
     )
-    start = time.perf_counter()
-    with _progress_bar(len(trials), err) as progress:
-        results = sweep(trials, executor, backend, progress)
-    wall = time.perf_counter() - start
-    jobs = f" on {executor.jobs} worker processes" if isinstance(executor, ProcessExecutor) else ""
-    print(f"dial: {len(trials)} trials in {wall:.1f} s wall{jobs}", file=err)
-    if options.trials > 1 and options.perturb_mm == 0:
-        print("dial: without --perturb, the trials at each tick are the same run", file=err)
 
-    rows = summarise(results)
-    scene = f" in scene {Path(options.scene).stem}" if options.scene else ""
-    title = (
-        f"{path}{scene}: {options.trials} trial{'s' if options.trials != 1 else ''} per tick, "
-        f"perturb {options.perturb_mm:g} mm, seed {options.seed}"
-    )
-    width = shutil.get_terminal_size().columns if out.isatty() else 120
-    out.write(render_table(rows, title, width))
-    for line in verdict(rows):
-        print(line, file=out)
-    status = 0 if fastest_reliable(rows) is not None else 1
-    if options.plot is not None:
-        try:
-            from dial.tune.plot import plot
-        except ImportError:
-            print(
-                "dial: --plot needs matplotlib: pip install 'dial[plot]' (or pip install "
-                "matplotlib)",
-                file=err,
-            )
-            status = 1
-        else:
-            try:
-                plot(rows, options.plot, title)
-            except (OSError, ValueError) as e:  # an unwritable path, an unknown file type
-                print(f"dial: --plot {options.plot}: {e}", file=err)
-                status = 1
-            else:
-                print(f"plot written to {options.plot}", file=out)
-    if options.json:
-        meta = {
-            "script": str(path),
-            "scene": options.scene,
-            "trials": options.trials,
-            "perturb_mm": options.perturb_mm,
-            "seed": options.seed,
-        }
-        print(json.dumps(to_json(rows, **meta)), file=out)
-    return status
+
+def _plot(rows: list[TickRow], file: Path, title: str, out: TextIO, err: TextIO) -> bool:
+    """Write the plot; False, with the reason on ``err``, when it could not be written."""
+    try:
+        from dial.tune.plot import plot
+    except ImportError:
+        print("dial: --plot needs matplotlib: pip install 'dial[plot]' (or pip install "
+              "matplotlib)", file=err)  # fmt: skip
+        return False
+    try:
+        plot(rows, file, title)
+    except (OSError, ValueError) as e:  # an unwritable path, an unknown file type
+        print(f"dial: --plot {file}: {e}", file=err)
+        return False
+    print(f"plot written to {file}", file=out)
+    return True

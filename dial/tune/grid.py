@@ -24,6 +24,7 @@ class Trial:
     seed: int  # the seed of the --perturb direction
     perturb_mm: float
     scene: str | None = None  # replaces the script's @scene, as dial run --scene
+    disturb: tuple[str, ...] = ()  # dial run --disturb SPECs, the same in every trial
 
 
 def parse_ticks(text: str) -> tuple[float, ...]:
@@ -67,11 +68,12 @@ def plan(
     seed: int = 0,
     perturb_mm: float = 0.0,
     scene: str | None = None,
+    disturb: tuple[str, ...] = (),
 ) -> list[Trial]:
     """Every trial of the sweep, tick by tick."""
     seeds = [trial_seed(seed, k) for k in range(trials)]
     return [
-        Trial(script, display, tick, k, seeds[k], perturb_mm, scene)
+        Trial(script, display, tick, k, seeds[k], perturb_mm, scene, disturb)
         for tick in ticks
         for k in range(trials)
     ]

@@ -46,14 +46,16 @@ Backend = Callable[[Trial], RunReport]
 
 
 def engine_backend(trial: Trial) -> RunReport:
-    """Run the trial on the MuJoCo engine, as ``dial run --tick --seed --perturb --scene``
-    would."""
+    """Run the trial on the MuJoCo engine, as ``dial run --tick --seed --perturb --scene
+    --disturb`` would."""
+    from dial.disturb import parse_disturbance
     from dial.engine import RunOptions, run  # in the worker: the parent needs no MuJoCo
     from dial.parser.check import load
     from dial.scene import load_scene_names
 
     script = load(trial.script, loader=load_scene_names, display=trial.display, scene=trial.scene)
-    options = RunOptions(tick=trial.tick, seed=trial.seed, perturb_mm=trial.perturb_mm)
+    disturb = tuple(parse_disturbance(d) for d in trial.disturb)  # texts cross the wire
+    options = RunOptions(trial.tick, seed=trial.seed, perturb_mm=trial.perturb_mm, disturb=disturb)
     result = run(script, options)
     summary = result.summary
     error = str(summary.error) if summary.error is not None else None

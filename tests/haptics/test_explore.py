@@ -14,6 +14,10 @@ import pytest
 from .test_procedures import _run
 
 SURFACE, CONTAIN = "scripts/explore_surface.dial", "scripts/containment.dial"
+# The procedures' own calls: containment.dial presses the top five times, then runs one side
+# per azimuth.
+TOP, SIDE = "scripts/containment_top.dial", "scripts/containment_side.dial"
+NESTED = {SURFACE: [], CONTAIN: [TOP] * 5 + [SIDE] * 8}
 
 
 # The pad starts 116.3 mm above the object's centre (20 mm south of it); the first touch is
@@ -45,7 +49,7 @@ def test_explore_calls_the_procedure_the_object_needs(
     conditions = {r["condition"]: r["value"] for r in records if r["kind"] == "condition"}
     assert conditions["!find"] is False and conditions["wide"] is wide
     calls = [r["script"] for r in records if r["kind"] == "call"]
-    assert calls == [called]
+    assert calls == [called, *NESTED[called]]
     other = CONTAIN if called == SURFACE else SURFACE
     ran = {r.get("script") for r in records if r["kind"] == "start"}
     assert called in ran and other not in ran

@@ -86,8 +86,8 @@ def test_unknown_scene_lists_the_bundled_names(tmp_path: Path) -> None:
 def test_containment_variants_change_only_the_target() -> None:
     box = load_world(worlds_dir() / "containment.toml")
     cyl = load_world(worlds_dir() / "containment_cylinder.toml")
-    assert box.locations["above_target"].body == "containment_box"
-    assert cyl.locations["above_target"].body == "containment_cylinder"
+    assert box.locations["over_top"].body == "containment_box"
+    assert cyl.locations["over_top"].body == "containment_cylinder"
     assert cyl.criteria[0].body == "containment_cylinder"  # type: ignore[attr-defined]
     assert cyl.model_path == box.model_path and cyl.poses == box.poses
 
@@ -257,7 +257,9 @@ def test_extends_a_bundled_scene_by_name_and_detects_cycles(tmp_path: Path) -> N
     )
     world = load_world(mine)
     assert world.name == "mine" and world.locations["side_135"].body == "containment_rounded"
-    programs = {"to_object", "to_top", "leave_top", "back_side", "retract_arm"}
+    programs = {"to_top", "down_top", "to_sides", "down_sides", "retract_arm"}
+    programs |= {f"to_top_{side}" for side in ("east", "west", "north", "south")}
+    programs |= {f"next_{azimuth}" for azimuth in (225, 270, 315, 0, 45, 90, 135)}
     assert load_scene_names("mine.toml", tmp_path).programs == programs
     write(tmp_path / "a.toml", 'extends = "b.toml"\n')
     write(tmp_path / "b.toml", 'extends = "a.toml"\n')
@@ -332,7 +334,7 @@ def test_explore_worlds_define_every_name_of_both_procedures() -> None:
     cylinder = load_world(worlds_dir() / "explore_cylinder.toml")
     for world in (block, cylinder):
         names = world.scene_names()
-        assert {"to_probe", "to_south", "to_object", "back_side", "leave_north"} <= names.programs
+        assert {"to_probe", "to_south", "to_sides", "next_135", "leave_north"} <= names.programs
         assert {"trace_point", "probe", "top"} <= set(names.poses)
         assert world.objects["block"] == world.objects["target"]
     assert (

@@ -6,6 +6,7 @@ The backends are module-level functions so that worker processes can unpickle th
 from __future__ import annotations
 
 import os
+import time
 from pathlib import Path
 
 from dial.testing.limited import limited_backend
@@ -40,4 +41,23 @@ def dying(trial: Trial) -> RunReport:
     """The worker process dies without a word, as on a crash in native code."""
     if trial.tick == BAD_TICK:
         os._exit(3)
+    return limited_backend(trial)
+
+
+def dies_once(trial: Trial) -> RunReport:
+    """The worker dies the first time it runs the trial at BAD_TICK, and only then.
+
+    A marker file beside the script remembers the death across worker processes.
+    """
+    marker = Path(trial.script).with_suffix(f".died-{trial.trial}")
+    if trial.tick == BAD_TICK and not marker.exists():
+        marker.touch()
+        os._exit(3)
+    return limited_backend(trial)
+
+
+def slow(trial: Trial) -> RunReport:
+    """Marks its start beside the script, then takes a second: for interrupting a sweep."""
+    Path(trial.script).with_suffix(f".started-{trial.tick:g}").touch()
+    time.sleep(1.0)
     return limited_backend(trial)

@@ -9,6 +9,7 @@ from pathlib import Path
 import pytest
 
 from dial.cli import main
+from dial.resources import resolve_script
 from dial.tune import plan
 from dial.tune.trial import engine_backend, run_trial
 
@@ -22,6 +23,15 @@ from dial.tune.trial import engine_backend, run_trial
         (["--ticks", "0.1:0.5:3", "--jobs", "0"], "dial: --jobs must be at least 1, got 0"),
         (["--ticks", "0.1:0.5:3", "--seed", "-1"], "dial: --seed must be 0 or more, got -1"),
         (["--ticks", "0.1:0.5:3", "--perturb", "-2"], "dial: --perturb must be 0 mm or more"),
+        (
+            ["--ticks", "0.1:0.5:3", "--disturb", "push body=x"],
+            "dial: --disturb 'push body=x': missing at=",
+        ),
+        (
+            ["--ticks", "0.1:0.5:3", "--disturb", "push body=nosuch force=1,0,0 at=0 for=1"],
+            "dial: --disturb 'push body=nosuch force=1,0,0 at=0 for=1': no body 'nosuch' in "
+            "this scene; valid bodies: hand_base, ",
+        ),
     ],
 )
 def test_usage_errors_exit_2_with_a_clear_message(
@@ -74,3 +84,20 @@ def test_scene_reaches_the_check_and_every_trial(
     bad = replace(trials[0], script=str(in_root / "scripts" / "explore.dial"), scene="kitchen")
     result = run_trial(engine_backend, bad)
     assert not result.ok and "unknown scene 'kitchen'" in (result.error or "")
+
+
+def test_a_disturbance_reaches_every_trial_and_the_json(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    # reactions.dial watches the index pad; with its tactile array out, the touch goes
+    # unnoticed and the light-touch criterion fails (tests/engine/test_disturb.py).
+    drop = "sense sensor=tactile:index at=0"
+    trials = plan(str(resolve_script("reactions")), "reactions.dial", (0.1,), 2, disturb=(drop,))
+    assert {t.disturb for t in trials} == {(drop,)}
+    disturbed = [run_trial(engine_backend, t) for t in trials]
+    assert [(r.ok, r.failed) for r in disturbed] == [(False, ("light_touch",))] * 2
+    assert run_trial(engine_backend, replace(trials[0], disturb=())).ok
+    args = ["tune", "reactions", "--ticks", "0.1:0.1:1", "--jobs", "1", "--json"]
+    assert main([*args, "--disturb", drop]) == 1
+    table = json.loads(capsys.readouterr().out.splitlines()[-1])
+    assert table["disturb"] == [drop] and table["ticks"][0]["successes"] == 0

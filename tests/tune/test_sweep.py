@@ -16,6 +16,7 @@ from dial.tune import (
     ProcessExecutor,
     SerialExecutor,
     TuneOptions,
+    failed_trial,
     fastest_reliable,
     parse_ticks,
     plan,
@@ -23,6 +24,7 @@ from dial.tune import (
     sweep,
     tune,
 )
+from dial.tune.executor import WORKER_DIED
 
 from . import helpers
 
@@ -75,18 +77,22 @@ def test_a_trial_that_raises_or_diverges_fails_alone_with_its_reason(
     assert best is not None and best.tick == 0.25
 
 
+@pytest.mark.parametrize("preload", [(), ("dial.testing.limited",)])
 def test_process_pool_gives_the_serial_results_and_survives_a_dead_worker(
-    tmp_path: Path,
+    tmp_path: Path, in_root: Path, preload: tuple[str, ...]
 ) -> None:
+    # With preload, a fork server forks the workers (it finds tests/ from the root).
+    pool = ProcessExecutor(2, preload=preload)
+    assert pool.method == ("forkserver" if preload else "spawn")
     trials = plan(str(helpers.write_go(tmp_path)), "go.dial", parse_ticks("0.2:0.35:4"), 1)
     serial = sweep(trials, SerialExecutor(), limited_backend)
-    assert sweep(trials, ProcessExecutor(2), limited_backend) == serial
+    assert sweep(trials, pool, limited_backend) == serial
     done: list[int] = []
-    dead = sweep(trials, ProcessExecutor(2), helpers.dying, done.append)
+    dead = sweep(trials, pool, helpers.dying, done.append)
     assert done[-1] == 4
     assert [r.tick for r in dead] == [0.2, 0.25, 0.3, 0.35]
     assert [r.ok for r in dead] == [False, True, False, True]
-    assert dead[2].error is not None and dead[2].error.startswith("worker process died")
+    assert dead[2] == failed_trial(trials[2], WORKER_DIED)
     assert [dead[i] for i in (0, 1, 3)] == [serial[i] for i in (0, 1, 3)]
 
 

@@ -1,0 +1,61 @@
+"""Where a finger touches, in the world frame: from its tactile array or from its links.
+
+A tactile array locates a contact on the distal pad face only. A contact on the end cap or on
+a phalanx is located from the finger's kinematics and geometry instead: the contact point of
+its links with whatever they touch, as an intrinsic contact sensor (a force/torque-sensing
+finger with a known link surface) would report it. The simulator's contact point stands in
+for that sensor's estimate: it lies on the link's surface, within half the penetration depth
+(well under 1 mm) of the touched surface.
+"""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+
+from dial.backend.snapshot import FloatArray
+from dial.instructions.types import FINGERS
+
+
+def tactile_point(depths: FloatArray, taxels: FloatArray) -> FloatArray | None:
+    """The depth-weighted centroid (3,) of the taxels that feel something, or None.
+
+    ``depths``: a fingertip's taxel depths (m), any shape, in sensor order; ``taxels``:
+    their (256, 3) world positions (``MujocoRobot.taxel_points``)."""
+    weights = np.asarray(depths, dtype=np.float64).reshape(-1)
+    if weights.max() <= 0.0:
+        return None
+    point: FloatArray = (weights @ taxels) / weights.sum()
+    return point
+
+
+def finger_bodies(model: mujoco.MjModel, finger: int) -> frozenset[int]:
+    """Ids of a finger's bodies: knuckle, proximal, medial and distal."""
+    prefix = f"hand_{FINGERS[finger]}_"
+    return frozenset(b for b in range(model.nbody) if model.body(b).name.startswith(prefix))
+
+
+def link_point(
+    model: mujoco.MjModel, data: mujoco.MjData, bodies: frozenset[int]
+) -> FloatArray | None:
+    """The deepest contact point (3,) between the ``bodies`` and anything outside the robot.
+
+    None when the finger touches nothing but the robot (or nothing at all)."""
+    best: tuple[float, FloatArray] | None = None
+    robot = _robot_root(model)
+    for contact in data.contact[: data.ncon]:
+        b1, b2 = int(model.geom_bodyid[contact.geom1]), int(model.geom_bodyid[contact.geom2])
+        if (b1 in bodies) == (b2 in bodies):
+            continue  # neither is the finger, or the finger touches itself
+        other = b2 if b1 in bodies else b1
+        if int(model.body_rootid[other]) == robot:
+            continue
+        if best is None or contact.dist < best[0]:
+            best = (float(contact.dist), np.array(contact.pos, dtype=np.float64))
+    return None if best is None else best[1]
+
+
+def _robot_root(model: mujoco.MjModel) -> int:
+    """The root body of the robot's tree (the PUMA's base, which carries the hand)."""
+    palm = int(mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, "hand_palm"))
+    return int(model.body_rootid[model.site_bodyid[palm]])
