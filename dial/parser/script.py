@@ -7,7 +7,7 @@ timeline.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
@@ -144,3 +144,29 @@ class Script:
     @property
     def tick(self) -> float | None:
         return self.program.tick
+
+
+def scripts_of(top: Script) -> list[Script]:
+    """``top`` and every script it calls, directly or through others, each once (by path)."""
+    found: dict[str, Script] = {}
+    todo = [top]
+    while todo:
+        script = todo.pop()
+        if script.path not in found:
+            found[script.path] = script
+            todo += _callees(script.timeline)
+    return list(found.values())
+
+
+def _callees(steps: tuple[Step, ...]) -> Iterator[Script]:
+    for step in steps:
+        if isinstance(step, TCall):
+            yield step.script
+        elif isinstance(step, TBlock):
+            for on in step.reactions:
+                yield from _callees(on.body)
+        elif isinstance(step, TRepeat):
+            yield from _callees(step.body)
+        elif isinstance(step, TIf):
+            yield from _callees(step.then)
+            yield from _callees(step.orelse)
