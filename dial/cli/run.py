@@ -162,8 +162,15 @@ def _run(args: argparse.Namespace, stop: StopRequest) -> int:
         print(f"dial: {result.error}", file=sys.stderr)
     if args.json:
         print(json.dumps(result.as_record()))
+    if result.unsaved is not None:
+        print(
+            f"dial: save {result.unsaved}: the run started no block after it; nothing was saved",
+            file=sys.stderr,
+        )
     if stopped is not None:
         return EXIT_STATUS.get(stopped, 130)
+    if result.unsaved is not None:
+        return 1
     if save_at is not None and not result.saved:
         print(
             f"dial: --save-at block:{save_at[0]}: the run started fewer blocks; nothing was saved",

@@ -146,9 +146,19 @@ class Session:
         if not target:
             self.console.write("save needs a file: save FILE\n")
         else:
+            if self._pending_save is not None:
+                self.console.write(f"(instead of {self._pending_save}) ")
             self._pending_save = Path(target)
-            self.console.write(f"the state will be saved to {target} at the next block boundary\n")
+            self.console.write(
+                f"the state will be saved to {target} at the next block boundary (if the run "
+                "starts another block)\n"
+            )
         return False
+
+    @property
+    def unsaved(self) -> Path | None:
+        """A ``save`` asked for while paused that no block boundary came to write."""
+        return self._pending_save
 
     def _say(self, text: str) -> None:
         if self.console is not None:

@@ -2,16 +2,20 @@
 
 from __future__ import annotations
 
+import io
 import os
 import pty
 import select
 import subprocess
 import sys
 import time
+from pathlib import Path
 
+import pytest
 import trio
 import trio.testing
 
+from dial.cli import main
 from dial.debug import ScriptedConsole, Session, parse_break
 from dial.parser import check_text
 from dial.scheduler.log import EventLog
@@ -66,6 +70,27 @@ def test_end_of_commands_lets_the_run_finish() -> None:
     _, (summary, console, _, _) = _fake_session(TEXT, ["tick"], step=True)
     assert summary.ok
     assert "end of commands: the run goes on without pausing" in "".join(console.transcript)
+
+
+def test_a_save_asked_for_after_the_last_block_is_not_lost_silently() -> None:
+    session, (summary, console, _, _) = _fake_session(
+        TEXT, ["save late.state", "continue"], breaks=[parse_break("tick:2", {"a", "b"})]
+    )
+    assert summary.ok and session.saved == []
+    assert session.unsaved == Path("late.state")
+    assert "(if the run starts another block)" in "".join(console.transcript)
+
+
+def test_a_save_that_never_came_is_exit_1(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # pour.dial is one block: a save asked for while it runs has no boundary to wait for.
+    state = tmp_path / "p.state"
+    monkeypatch.setattr(sys, "stdin", io.StringIO(f"save {state}\ncontinue\n"))
+    assert main(["run", "pour.dial", "--break", "tick:30", "--quiet"]) == 1
+    err = capsys.readouterr().err
+    assert err == f"dial: save {state}: the run started no block after it; nothing was saved\n"
+    assert not state.exists()
 
 
 def test_a_scripted_session_through_stdin() -> None:
