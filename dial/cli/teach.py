@@ -70,7 +70,7 @@ def cmd_teach(args: argparse.Namespace) -> int:
     if args.viewer:
         from dial.recording.viewer import require_display
 
-        require_display("--viewer")
+        require_display("--viewer", instead="--snapshot DIR")  # teach has no --record
     from dial.teach.app import teach
 
     snapshot = Path(args.snapshot) if args.snapshot else None

@@ -173,6 +173,7 @@ def test_viewer_without_a_display_is_one_line(tmp_path: Path) -> None:
     done = dial("teach", "--scene", "pour", "--viewer")
     assert done.returncode == 1
     assert done.stderr.startswith("dial: --viewer needs a display")
+    assert done.stderr.endswith("; use --snapshot DIR instead\n")  # not dial run's --record
     assert "Traceback" not in done.stderr
     assert len(done.stderr.strip().splitlines()) == 1
 
