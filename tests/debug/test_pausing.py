@@ -15,9 +15,12 @@ import pytest
 import trio
 import trio.testing
 
+import dial
 from dial.cli import main
 from dial.debug import ScriptedConsole, Session, parse_break
 from dial.parser import check_text
+from dial.recording.frames import Batch
+from dial.recording.observers import Recorder
 from dial.scheduler.log import EventLog
 from dial.scheduler.runner import Runner
 from dial.scheduler.signals import StopRequest
@@ -151,3 +154,46 @@ def test_show_numbers_blocks_as_the_run_counts_them() -> None:
     shown = [(s.block, s.line) for s in expand(script).sections if s.block is not None]
     ran = [(r["number"], r["line"]) for r in run_fake(script).log.of("block")]
     assert shown == ran and len(ran) == 8
+
+
+class _Sink:
+    """A rerun sink that keeps the simulated time of every frame sent to the viewer."""
+
+    batch = 250  # frames per send: without the pause's own send, none would be out yet
+
+    def __init__(self) -> None:
+        self.sent: list[int] = []
+
+    def scene(self, *args: object) -> None:
+        pass
+
+    def record(self, *args: object) -> None:
+        pass
+
+    def frames(self, batch: Batch) -> None:
+        self.sent += [int(t) for t in batch.time_ns]
+
+    def close(self) -> None:
+        pass
+
+
+class _Watching(ScriptedConsole):
+    """Notes, at each command asked for, the last frame the viewer has been sent."""
+
+    def __init__(self, commands: list[str], sink: _Sink) -> None:
+        super().__init__(commands)
+        self.sink, self.shown = sink, list[int | None]()
+
+    async def read(self, prompt: str, stop: StopRequest) -> str | None:
+        self.shown.append(self.sink.sent[-1] if self.sink.sent else None)
+        return await super().read(prompt, stop)
+
+
+def test_a_live_recording_shows_the_paused_state() -> None:
+    sink = _Sink()
+    console = _Watching(["period", "continue"], sink)
+    recorder = Recorder(sink, "pour")  # type: ignore[arg-type]  # the sink's four methods
+    dial.run("pour.dial", breaks=["tick:3"], console=console, observers=[recorder])
+    # Paused at the start of tick 3 (t = 0.5 s), then one period on, mid-tick (0.51 s, a
+    # period the recording's 50 Hz would skip): the viewer has each moment while paused.
+    assert console.shown == [500_000_000, 510_000_000]
