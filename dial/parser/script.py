@@ -154,19 +154,20 @@ def scripts_of(top: Script) -> list[Script]:
         script = todo.pop()
         if script.path not in found:
             found[script.path] = script
-            todo += _callees(script.timeline)
+            todo += [s.script for s in iter_steps(script.timeline) if isinstance(s, TCall)]
     return list(found.values())
 
 
-def _callees(steps: tuple[Step, ...]) -> Iterator[Script]:
+def iter_steps(steps: tuple[Step, ...]) -> Iterator[Step]:
+    """Every step of ``steps`` and of the bodies in them (loops, branches, reactions), in
+    file order, a block before its reactions; not into called scripts."""
     for step in steps:
-        if isinstance(step, TCall):
-            yield step.script
-        elif isinstance(step, TBlock):
+        yield step
+        if isinstance(step, TBlock):
             for on in step.reactions:
-                yield from _callees(on.body)
+                yield from iter_steps(on.body)
         elif isinstance(step, TRepeat):
-            yield from _callees(step.body)
+            yield from iter_steps(step.body)
         elif isinstance(step, TIf):
-            yield from _callees(step.then)
-            yield from _callees(step.orelse)
+            yield from iter_steps(step.then)
+            yield from iter_steps(step.orelse)
