@@ -81,6 +81,20 @@ def test_resuming_an_edited_later_block_runs_the_edit(
     assert ends and ends[-1]["outcome"] == "done"
 
 
+def test_a_resumed_summary_times_the_resumed_part(
+    saved: tuple[Path, Path], capsys: pytest.CaptureFixture[str]
+) -> None:
+    script, state = saved
+    main(["run", str(script), "--resume", str(state)])
+    line = next(x for x in capsys.readouterr().out.splitlines() if x.startswith("simulated "))
+    total, rest = line.removeprefix("simulated ").split(" s (", 1)
+    part, rest = rest.split(" s after resuming at ", 1)
+    since, rest = rest.split(" s) in ", 1)
+    assert rest.split(" s wall (real-time factor ", 1)[1]  # counted over the part
+    assert float(part) == pytest.approx(float(total) - float(since), abs=0.011)
+    assert float(since) > 30  # lightbulb's block 12 starts at 30.56 s
+
+
 def test_an_edited_earlier_line_is_named(
     saved: tuple[Path, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
