@@ -57,6 +57,7 @@ class Session:
     where: Callable[[], str] = lambda: ""
     on_pause: Callable[[], None] = lambda: None
     each_period: bool = False
+    top: str = ""  # the top script's path: its lines need no file name
     _next_tick: bool = False
     _pending_save: Path | None = None
     _last: str = ""
@@ -84,7 +85,9 @@ class Session:
             reasons.append("step")
         reasons += [f"--break tick:{tick}" for b in self.breaks if b.tick == tick]
         names = {b.event for b in self.breaks if b.event is not None}
-        reasons += [f"--break {r.event} (line {r.line})" for r in starting if r.event in names]
+        # A called script's line is named with its file: "line 70" alone reads as the top's.
+        where = "line " if script.path == self.top else f"{Path(script.path).name}:"
+        reasons += [f"--break {r.event} ({where}{r.line})" for r in starting if r.event in names]
         self._next_tick = False
         if reasons:
             await self.pause(", ".join(reasons))

@@ -35,7 +35,9 @@ def _fake_session(text: str, commands: list[str], **kwargs: object) -> tuple[Ses
     robot, log, stop = FakeRobot(), EventLog(), StopRequest()
     console = ScriptedConsole(commands)
     ticks: list[int] = []
-    session = Session(stop, console, where=lambda: f"tick {ticks[-1] if ticks else 0}", **kwargs)
+    session = Session(
+        stop, console, where=lambda: f"tick {ticks[-1] if ticks else 0}", top=script.path, **kwargs
+    )
     runner = Runner(robot, FakeFactory(robot), 0.1, log, stop=stop, hooks=session)
     summary = trio.run(runner.run, script, clock=trio.testing.MockClock(autojump_threshold=0))
     return session, (summary, console, robot, log)
@@ -61,6 +63,17 @@ def test_break_on_an_event_pauses_before_it_starts() -> None:
         TEXT, ["continue"], breaks=[parse_break("b", {"a", "b"})]
     )
     assert summary.ok and "--break b (line 4" in "".join(console.transcript)
+
+
+def test_a_break_in_a_called_script_names_its_file(tmp_path: Path) -> None:
+    from .test_resume import SUB, TOP
+
+    (tmp_path / "top.dial").write_text(TOP)
+    (tmp_path / "sub.dial").write_text(SUB)
+    console = ScriptedConsole(["continue", "continue"])
+    dial.run(tmp_path / "top.dial", breaks=["to", "open"], console=console)
+    text = "".join(console.transcript)
+    assert "--break to (line 6)" in text and "--break open (sub.dial:6)" in text
 
 
 def test_quit_stops_the_run_with_every_effector_held() -> None:
