@@ -175,6 +175,7 @@ def test_viewer_without_a_display_is_one_line(tmp_path: Path) -> None:
     done = dial("teach", "--scene", "pour", "--viewer")
     assert done.returncode == 1
     assert done.stderr.startswith("dial: --viewer needs a display")
+    assert done.stderr.endswith("; use --snapshot DIR instead\n")  # not dial run's --record
     assert "Traceback" not in done.stderr
     assert len(done.stderr.strip().splitlines()) == 1
 
@@ -182,6 +183,8 @@ def test_viewer_without_a_display_is_one_line(tmp_path: Path) -> None:
 def test_usage_errors_exit_2(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["teach", "--scene", "nowhere"]) == 2
     assert "--scene: 'nowhere' is neither a file nor a bundled scene" in capsys.readouterr().err
+    assert main(["world", "nowhere"]) == 2
+    assert capsys.readouterr().err.startswith("dial: SCENE: 'nowhere' is neither a file")
     assert main(["world", "pour", "--picture", "x.jpg"]) == 2
     assert "--picture writes a .png file" in capsys.readouterr().err
     assert main(["teach", "--scene", "pour", "--viewer", "--snapshot", "d"]) == 2
