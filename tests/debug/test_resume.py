@@ -3,6 +3,7 @@ final state are the uninterrupted run's, byte for byte apart from wall time."""
 
 from __future__ import annotations
 
+import json
 import shutil
 from collections.abc import Callable
 from pathlib import Path
@@ -228,7 +229,7 @@ def test_resume_from_another_directory(tmp_path: Path, monkeypatch: pytest.Monke
             for r in records
         ]
 
-    tail = named([r for r in _records(resumed) if r["kind"] not in ("scene", "resume")])
-    assert len(tail) > 4 and tail == named(_records(full))[-len(tail) :]
+    tail = named([r for r in json_records(resumed) if r["kind"] not in ("scene", "resume")])
+    assert len(tail) > 4 and tail == named(json_records(full))[-len(tail) :]
     assert [r["value"] for r in resumed.log.of("condition")] == [True, True]
     assert resumed.final_qpos == full.final_qpos
