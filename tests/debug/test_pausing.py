@@ -100,10 +100,11 @@ def test_a_save_asked_for_after_the_last_block_is_not_lost_silently() -> None:
 def test_a_save_that_never_came_is_exit_1(
     monkeypatch: pytest.MonkeyPatch, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    # pour.dial is one block: a save asked for while it runs has no boundary to wait for.
+    # retract_arm runs in pour.dial's last block: a save asked for there has no boundary
+    # to wait for.
     state = tmp_path / "p.state"
     monkeypatch.setattr(sys, "stdin", io.StringIO(f"save {state}\ncontinue\n"))
-    assert main(["run", "pour.dial", "--break", "tick:30", "--quiet"]) == 1
+    assert main(["run", "pour.dial", "--break", "retract_arm", "--quiet"]) == 1
     err = capsys.readouterr().err
     assert err == f"dial: save {state}: the run started no block after it; nothing was saved\n"
     assert not state.exists()
