@@ -127,3 +127,20 @@ def test_check_of_a_latin1_script(tmp_path: Path, capsys: pytest.CaptureFixture[
     assert main(["check", str(path)]) == 1
     out = capsys.readouterr().out
     assert out.startswith(f"{path}:2:7: not UTF-8 text (byte 0xE9); dial scripts are UTF-8\n")
+
+
+def test_world_of_a_latin1_world_file(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    path = tmp_path / "w.toml"
+    path.write_bytes('extends = "surface"\n# caf\xe9\n'.encode("latin-1"))
+    assert main(["world", str(path)]) == 1
+    assert capsys.readouterr().err == f"dial: {path}: not UTF-8 text (byte 25); TOML is UTF-8\n"
+
+
+def test_teach_snapshot_into_a_folder_it_cannot_make(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    blocker = tmp_path / "file"
+    blocker.write_text("")  # a file where the folder's parent should be
+    assert main(["teach", "--scene", "surface", "--snapshot", str(blocker / "shots")]) == 1
+    err = capsys.readouterr().err
+    assert err == f"dial: --snapshot: cannot make the folder {blocker / 'shots'}: Not a directory\n"
