@@ -17,7 +17,10 @@ from dial.tune.trial import engine_backend, run_trial
 @pytest.mark.parametrize(
     ("args", "message"),
     [
-        (["--ticks", "0.5:0.1:3"], "dial: --ticks: need 0 < A <= B, got A=0.5 s and B=0.1 s"),
+        (
+            ["--ticks", "0.5:0.1:3"],
+            "dial: --ticks: need 0 < A <= B <= 60 s (as @tick), got A=0.5 s and B=0.1 s",
+        ),
         (["--ticks", "0.1:0.5"], "dial: --ticks: expected A:B:N (e.g. 0.05:0.5:10), got"),
         (["--ticks", "0.1:0.5:3", "--trials", "0"], "dial: --trials must be at least 1, got 0"),
         (["--ticks", "0.1:0.5:3", "--jobs", "0"], "dial: --jobs must be at least 1, got 0"),
