@@ -81,6 +81,10 @@ def cmd_tune(args: argparse.Namespace) -> int:
     at_least("--trials", args.trials, 1)
     at_least("--jobs", args.jobs, 1)
     api.check_options(None, 1.0, args.seed, args.perturb)
+    if args.plot is not None:  # a sweep can take hours: say so now, not after it
+        if Path(args.plot).suffix.lower() != ".png":
+            raise UsageError(f"--plot writes a .png file, not '{args.plot}'")
+        api.writable(args.plot, "the plot")
     for spec in args.disturb:  # a bad SPEC is a usage error before anything runs
         parse_disturbance(spec)
     try:
