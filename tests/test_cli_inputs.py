@@ -3,6 +3,9 @@ status for every case, never a traceback."""
 
 from __future__ import annotations
 
+import os
+import resource
+import signal
 import subprocess
 import sys
 from pathlib import Path
@@ -89,13 +92,28 @@ def test_fmt_of_a_file_it_cannot_rewrite(
 ) -> None:
     path = tmp_path / "x.dial"
     path.write_text("% a  get_joints\na #\n")
-
-    def refuse(self: Path, *args: object, **kwargs: object) -> int:
-        raise PermissionError(13, "Permission denied")
-
-    monkeypatch.setattr(Path, "write_text", refuse)  # as a read-only file would (root or not)
+    monkeypatch.setattr(os, "access", lambda *args: False)  # as a read-only file (root or not)
     assert main(["fmt", str(path)]) == 1
     assert capsys.readouterr().err == f"dial: cannot rewrite {path}: Permission denied\n"
+    assert path.read_text() == "% a  get_joints\na #\n" and os.listdir(tmp_path) == ["x.dial"]
+
+
+def test_fmt_on_a_full_disk_keeps_the_script_whole(tmp_path: Path) -> None:
+    """A file-size limit stands in for a full disk: the rewrite fails part-way through."""
+    path = tmp_path / "x.dial"
+    original = "% a  get_joints\n" + "a #\n" * 2000  # 8 kB, to be re-aligned
+    path.write_text(original)
+
+    def limit() -> None:
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # a write past the limit fails (EFBIG)
+        resource.setrlimit(resource.RLIMIT_FSIZE, (4096, 4096))
+
+    done = subprocess.run(
+        [*DIAL, "fmt", str(path)], capture_output=True, text=True, preexec_fn=limit
+    )
+    assert done.returncode == 1 and "Traceback" not in done.stderr
+    assert done.stderr == f"dial: cannot rewrite {path}: File too large\n"
+    assert path.read_text() == original and os.listdir(tmp_path) == ["x.dial"]
 
 
 def test_an_observer_that_fails_mid_run_stops_it_cleanly(tmp_path: Path) -> None:
