@@ -82,6 +82,8 @@ class Disturbances:
 
     def due(self, step: int, substeps: int) -> bool:
         """Whether one begins or ends within the next ``substeps`` physics steps."""
+        if not self._boundaries:  # the common case: no --disturb
+            return False
         return any(step <= b < step + substeps for b in self._boundaries)
 
     def apply(self, step: int, data: mujoco.MjData, happened: list[Happening], t: float) -> None:

@@ -33,12 +33,16 @@ class Safety:
         arm_range = model.jnt_range[model.actuator_trnid[index.arm_actuators, 0]]
         self._arm_lo = arm_range[:, 0] - LIMIT_SLACK
         self._arm_hi = arm_range[:, 1] + LIMIT_SLACK
+        # One test per control period: |q - mid| > half is outside [lo, hi].
+        self._arm_mid = (self._arm_lo + self._arm_hi) / 2.0
+        self._arm_half = (self._arm_hi - self._arm_lo) / 2.0
         self._pinned_at = index.tension_limit - 1e-6
         # Views where the addresses run in order (a read through them copies nothing).
         self._arm_q = _view(data.qpos, index.arm_qpos)
         self._tensions = _view(data.sensordata, index.tension_sensors)
         self.saturated_since = np.full(32, -1.0)
         self.saturation_logged = np.zeros(32, dtype=bool)
+        self._tracking = False  # a tendon is pinned now, or one was logged and still is
 
     def check(self, time: float, happened: list[Happening]) -> str | None:
         """A fault message, or None; appends a ``warning`` for a tendon held at its limit."""
@@ -49,15 +53,21 @@ class Safety:
             if warning.number:
                 return "the physics diverged (MuJoCo reset an unstable state)"
         q = self._arm_q()
-        if (q < self._arm_lo).any() or (q > self._arm_hi).any():
-            j = int(np.flatnonzero((q < self._arm_lo) | (q > self._arm_hi))[0])
+        beyond = np.abs(q - self._arm_mid) > self._arm_half
+        if beyond.any():
+            j = int(np.flatnonzero(beyond)[0])
             return f"PUMA joint {j + 1} is beyond its limit ({np.degrees(q[j]):.1f} deg)"
         # A tendon pinned at its limit is not a fault (a fist pressed into the palm does it),
         # but a researcher should know: log it once per episode.
-        pinned = self._tensions() >= self._pinned_at
+        tensions = self._tensions()
+        if not self._tracking and tensions.max() < self._pinned_at:  # the common case
+            return None
+        pinned = tensions >= self._pinned_at
         if not pinned.any() and not self.saturation_logged.any():
             self.saturated_since.fill(-1.0)
+            self._tracking = False
             return None
+        self._tracking = True
         self.saturated_since[~pinned] = -1.0
         self.saturated_since[pinned & (self.saturated_since < 0)] = time
         held = pinned & (time - self.saturated_since >= SATURATION_LIMIT_S)
