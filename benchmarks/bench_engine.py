@@ -191,13 +191,12 @@ def pour_physics(script_arg: str, today: _Replay, repeat: int) -> None:
 
 
 def watched_overhead(repeat: int) -> None:
-    """The overhead with a monitor armed all through pour's long block (it never fires):
+    """The overhead with a monitor armed all through pour's last block (it never fires):
     the driver steps one physics step at a time and tests the condition after each."""
     text = resolve_script("pour.dial").read_text(encoding="utf-8")
     lines = text.splitlines()
     last = max(i for i, line in enumerate(lines) if line.startswith("retract_arm "))
-    width = max(len(line) for line in lines[last - 8 : last + 1])
-    lines.insert(last + 1, "idle" + " " * 8 + "~" * (width - 12))
+    lines.insert(last + 1, "idle" + " " * 8 + "~" * (len(lines[last]) - 12))
     lines.insert(last + 2, "@on idle\n@end")
     lines.insert(
         lines.index(next(ln for ln in lines if ln.startswith("% retract_arm"))) + 1,
@@ -207,7 +206,7 @@ def watched_overhead(repeat: int) -> None:
         path = Path(folder) / "pour_watched.dial"
         path.write_text("\n".join(lines) + "\n", encoding="utf-8")
         script = load(path, loader=load_scene_names)
-        print("watched spans: pour.dial with a monitor armed through its whole block")
+        print("watched spans: pour.dial with a monitor armed through its whole last block")
         engine_overhead(script, repeat)
 
 

@@ -1,8 +1,8 @@
 """`dial tune` speed-up with J worker processes, and the same sweep on a local Ray (DESIGN 7).
 
 Runs the same sweep with `--jobs 1` and with `--jobs J` (default 2) as `dial tune` does
-(workers forked from a server that imported the engine once, each compiling its models
-once; `--method spawn` for fresh interpreters instead) and prints the speed-up (target:
+(spawned workers, each compiling its models once; `--method forkserver` forks them from a
+server that imported the engine once instead) and prints the speed-up (target:
 1.8 or more with 2 jobs on a 2-core machine). Then it runs the sweep as Ray tasks on a
 local Ray with J CPUs, started for it as `dial tune --executor ray` does, and prints its
 wall time beside, with the time Ray took to start apart. Every run must give the same
@@ -16,7 +16,7 @@ speed-up is printed a second time with that wait taken out of each worker's time
 figure for a machine with nothing else running.
 
     python benchmarks/bench_tune.py [SCRIPT] [--ticks A:B:N] [--trials K] [--jobs J]
-                                    [--repeat N] [--method forkserver|spawn] [--no-ray]
+                                    [--repeat N] [--method spawn|forkserver] [--no-ray]
 """
 
 from __future__ import annotations
@@ -71,14 +71,17 @@ def _processes(
     trials: list[Trial], jobs: int, method: str
 ) -> tuple[float, float, float, list[TrialResult]]:
     """Wall time, the same without the waits for CPU, workers' CPU time, and the results."""
-    with tempfile.TemporaryDirectory() as folder:
-        os.environ[WAITS] = folder  # read by the workers: set before the pool starts
-        cpu = _children_cpu()
-        start = time.perf_counter()
-        executor = ProcessExecutor(jobs, method, models.install, models.PRELOAD)
-        results = sweep(trials, executor, _engine_noting_waits)
-        wall = time.perf_counter() - start
-        alone = _without_waits(start, wall, Path(folder))
+    # One folder for every pool (set in main): a fork server keeps the environment it was
+    # started with, so the folder must outlive the first pool.
+    folder = Path(os.environ[WAITS])
+    for note in folder.iterdir():
+        note.unlink()
+    cpu = _children_cpu()
+    start = time.perf_counter()
+    executor = ProcessExecutor(jobs, method, models.install, models.PRELOAD)
+    results = sweep(trials, executor, _engine_noting_waits)
+    wall = time.perf_counter() - start
+    alone = _without_waits(start, wall, folder)
     return wall, alone, _children_cpu() - cpu, results  # workers are joined at shutdown
 
 
@@ -99,9 +102,11 @@ def main() -> None:
     parser.add_argument("--trials", type=int, default=2)
     parser.add_argument("--jobs", type=int, default=2)
     parser.add_argument("--repeat", type=int, default=1)
-    parser.add_argument("--method", default="forkserver", choices=("forkserver", "spawn"))
+    parser.add_argument("--method", default="spawn", choices=("spawn", "forkserver"))
     parser.add_argument("--no-ray", action="store_true", help="only the process pool")
     args = parser.parse_args()
+    waits = tempfile.TemporaryDirectory()  # lives until the process ends
+    os.environ[WAITS] = waits.name  # read by the workers: set before any pool starts
 
     path = resolve_script(args.script)
     trials = plan(str(path.resolve()), str(path), parse_ticks(args.ticks), args.trials)

@@ -24,7 +24,7 @@ from dial.disturb import Disturbance, parse_disturbance
 from dial.errors import DialError, OptionError
 from dial.instructions.scene_names import SceneNotFoundError
 from dial.parser.check import load as parse_and_check
-from dial.parser.script import Script, Step, TBlock, TCall, TIf, TRepeat
+from dial.parser.script import Script, scripts_of
 from dial.resources import resolve_script
 from dial.scene import load_scene_names
 from dial.scene.resolve import scene_option
@@ -213,29 +213,7 @@ def _pausing(
 
 def _event_names(script: Script) -> set[str]:
     """The events of a script and of every script it calls (``--break EVENT``)."""
-    names, todo, seen = set(), [script], set()
-    while todo:
-        current = todo.pop()
-        if current.path in seen:
-            continue
-        seen.add(current.path)
-        names |= set(current.events)
-        todo += list(_callees(current.timeline))
-    return names
-
-
-def _callees(steps: tuple[Step, ...]) -> Iterator[Script]:
-    for step in steps:
-        if isinstance(step, TCall):
-            yield step.script
-        elif isinstance(step, TBlock):
-            for on in step.reactions:
-                yield from _callees(on.body)
-        elif isinstance(step, TRepeat):
-            yield from _callees(step.body)
-        elif isinstance(step, TIf):
-            yield from _callees(step.then)
-            yield from _callees(step.orelse)
+    return {name for called in scripts_of(script) for name in called.events}
 
 
 def _check_watching(

@@ -2,10 +2,15 @@
 
 from __future__ import annotations
 
+import json
 import os
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import pytest
+
+if TYPE_CHECKING:
+    from dial import RunResult
 
 ROOT = Path(__file__).resolve().parent.parent
 DATA = ROOT / "tests" / "data"
@@ -19,6 +24,16 @@ def golden(path: Path, actual: str) -> None:
         return
     assert path.is_file(), f"missing golden file {path}; run with DIAL_UPDATE_GOLDEN=1"
     assert actual == path.read_text(encoding="utf-8")
+
+
+def json_records(result: RunResult) -> list[dict[str, object]]:
+    """A run's log as JSON text would hold it, without the summary's wall time."""
+    out = []
+    for record in result.log.records:
+        record = json.loads(json.dumps(record))
+        record.pop("wall_time", None)
+        out.append(record)
+    return out
 
 
 @pytest.fixture

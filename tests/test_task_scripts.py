@@ -64,20 +64,37 @@ def test_lightbulb_tick_ranges_follow_the_paper() -> None:
 
 def test_pour_tick_ranges_follow_the_paper() -> None:
     runs = _ranges("pour.dial")
-    assert runs[:9] == [
-        ("get_top", 1, 13),
-        ("pit_top", 1, 13),
-        ("grab_top", 14, 14),
-        ("lift_top", 15, 24),
-        ("pit_top", 25, 28),
-        ("to_grasp", 29, 35),
-        ("prepit", 29, 35),
-        ("grabpit", 36, 36),
-        ("pourpit", 37, 44),
+    assert runs[:2] == [("get_top", 1, 13), ("pit_top", 1, 13)]
+    # Added to the paper's script: feel for the knob along two axes and centre over it, each
+    # time once the thumb is at rest (a while loop: shown once, run zero or more times), then
+    # locate lid and pitcher from where the hand is.
+    assert runs[2:11] == [
+        ("settle", 14, 14),
+        ("feel_knob", 15, 15),
+        ("centre", 16, 17),
+        ("turn", 18, 23),
+        ("settle", 24, 24),
+        ("feel_knob", 25, 25),
+        ("centre", 26, 27),
+        ("turn_back", 28, 33),
+        ("found", 34, 34),
     ]
-    (release, r0, r1), (retract, t0, _) = runs[9:]
+    # The paper's lid and approach; the last 13 cm down beside the pitcher is watched, and
+    # each reaction (thumb, middle) backs up and waits for thumb and middle to rest.
+    assert runs[11:24] == [
+        ("grab_top", 34, 34),
+        ("lift_top", 35, 44),
+        ("pit_top", 45, 48),
+        ("to_grasp", 49, 54),
+        ("prepit", 49, 54),
+        ("settle", 55, 55),
+        ("lower_pit", 56, 58),
+        *[("back_up", 59, 60), ("settle", 61, 61), ("settle", 62, 62)] * 2,
+    ]
+    assert runs[24:26] == [("grabpit", 63, 63), ("pourpit", 64, 71)]
+    (release, r0, r1), (retract, t0, _) = runs[26:]
     assert (release, retract) == ("prepit", "retract_arm")
-    assert 44 < r0 <= r1 < t0
+    assert 71 < r0 <= r1 < t0
 
 
 @pytest.mark.parametrize("name", ["lightbulb.dial", "pour.dial"])

@@ -56,6 +56,9 @@ class _Memo:
     def get(self, key: tuple[object, ...]) -> object:
         return self._values.get(key)
 
+    def clear(self) -> None:
+        self._values.clear()
+
     def put(self, key: tuple[object, ...], value: object) -> None:
         self._values[key] = value
         if len(self._values) > self.SIZE:
@@ -63,6 +66,11 @@ class _Memo:
 
 
 _MEMO = _Memo()
+
+
+def forget_solutions() -> None:
+    """Empty the memo: the next solves cost what they cost in a fresh process (benchmarks)."""
+    _MEMO.clear()
 
 
 class _Base:

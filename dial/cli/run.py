@@ -163,8 +163,15 @@ def _run(args: argparse.Namespace, stop: StopRequest) -> int:
         print(f"dial: {result.error}", file=sys.stderr)
     if args.json:
         print(json.dumps(result.as_record()))
+    if result.unsaved is not None:
+        print(
+            f"dial: save {result.unsaved}: the run started no block after it; nothing was saved",
+            file=sys.stderr,
+        )
     if stopped is not None:
         return EXIT_STATUS.get(stopped, 130)
+    if result.unsaved is not None:
+        return 1
     if save_at is not None and not result.saved:
         print(
             f"dial: --save-at block:{save_at[0]}: the run started fewer blocks; nothing was saved",
@@ -216,11 +223,23 @@ def summary_text(result: RunResult) -> str:
             f"  tick {r['tick']:4d}  monitor '@on {r['condition']}' fired at "
             f"t={r['t']:.3f} s (line {r['line']})"
         )
-    lines.append(
-        f"simulated {s.sim_time:.2f} s in {result.wall_time:.2f} s wall "
-        f"(real-time factor {result.real_time_factor:.1f}), {result.physics_steps} physics steps"
-    )
+    lines.append(_times(result))
     for name, ok in result.success.items():
         lines.append(f"  [{'x' if ok else ' '}] {name}: {result.details[name]}")
     lines.append("OK" if result.ok else "FAILED")
     return "\n".join(lines) + "\n"
+
+
+def _times(result: RunResult) -> str:
+    """Simulated and wall time; a resumed run's real-time factor counts from the resume."""
+    s = result.summary
+    resumed = result.log.of("resume")
+    t = resumed[0]["t"] if resumed else 0.0
+    since = t if isinstance(t, float | int) else 0.0
+    span = s.sim_time - since
+    factor = span / result.wall_time if result.wall_time > 0 else float("inf")
+    after = f" ({span:.2f} s after resuming at {since:.2f} s)" if resumed else ""
+    return (
+        f"simulated {s.sim_time:.2f} s{after} in {result.wall_time:.2f} s wall "
+        f"(real-time factor {factor:.1f}), {result.physics_steps} physics steps"
+    )

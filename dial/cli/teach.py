@@ -52,11 +52,11 @@ def add_parsers(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> Non
     p.set_defaults(func=cmd_world)
 
 
-def _scene(arg: str) -> str:
+def _scene(arg: str, option: str = "--scene") -> str:
     from dial.scene.resolve import scene_option
 
     try:
-        return scene_option(arg)
+        return scene_option(arg, option)
     except SceneNotFoundError as e:
         raise UsageError(str(e)) from None
 
@@ -70,7 +70,7 @@ def cmd_teach(args: argparse.Namespace) -> int:
     if args.viewer:
         from dial.recording.viewer import require_display
 
-        require_display("--viewer")
+        require_display("--viewer", instead="--snapshot DIR")  # teach has no --record
     from dial.teach.app import teach
 
     snapshot = Path(args.snapshot) if args.snapshot else None
@@ -78,7 +78,7 @@ def cmd_teach(args: argparse.Namespace) -> int:
 
 
 def cmd_world(args: argparse.Namespace) -> int:
-    scene = _scene(args.scene)
+    scene = _scene(args.scene, "SCENE")  # an argument here, not --scene
     if args.picture:
         if Path(args.picture).suffix.lower() != ".png":
             raise UsageError(f"--picture writes a .png file, not '{args.picture}'")

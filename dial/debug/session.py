@@ -57,6 +57,7 @@ class Session:
     where: Callable[[], str] = lambda: ""
     on_pause: Callable[[], None] = lambda: None
     each_period: bool = False
+    top: str = ""  # the top script's path: its lines need no file name
     _next_tick: bool = False
     _pending_save: Path | None = None
     _last: str = ""
@@ -84,7 +85,9 @@ class Session:
             reasons.append("step")
         reasons += [f"--break tick:{tick}" for b in self.breaks if b.tick == tick]
         names = {b.event for b in self.breaks if b.event is not None}
-        reasons += [f"--break {r.event} (line {r.line})" for r in starting if r.event in names]
+        # A called script's line is named with its file: "line 70" alone reads as the top's.
+        where = "line " if script.path == self.top else f"{Path(script.path).name}:"
+        reasons += [f"--break {r.event} ({where}{r.line})" for r in starting if r.event in names]
         self._next_tick = False
         if reasons:
             await self.pause(", ".join(reasons))
@@ -146,9 +149,19 @@ class Session:
         if not target:
             self.console.write("save needs a file: save FILE\n")
         else:
+            if self._pending_save is not None:
+                self.console.write(f"(instead of {self._pending_save}) ")
             self._pending_save = Path(target)
-            self.console.write(f"the state will be saved to {target} at the next block boundary\n")
+            self.console.write(
+                f"the state will be saved to {target} at the next block boundary (if the run "
+                "starts another block)\n"
+            )
         return False
+
+    @property
+    def unsaved(self) -> Path | None:
+        """A ``save`` asked for while paused that no block boundary came to write."""
+        return self._pending_save
 
     def _say(self, text: str) -> None:
         if self.console is not None:

@@ -52,7 +52,9 @@ def session(
         assert runner.loop is not None
         return state_text(paused_view(top, runner.loop, robot))
 
-    return Session(stop, console, breaks, step, save_at, save, describe, where, on_pause)
+    return Session(
+        stop, console, breaks, step, save_at, save, describe, where, on_pause, top=top.path
+    )
 
 
 def paused_view(top: Script, loop: TickLoop[Any], robot: MujocoRobot) -> PausedView:

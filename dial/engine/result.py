@@ -57,6 +57,7 @@ class RunResult:
     final_qpos: list[float] = field(default_factory=list)
     disturbances: tuple[str, ...] = ()
     saved: tuple[tuple[int, Path], ...] = ()  # (block number, state file) written
+    unsaved: Path | None = None  # a paused run's 'save FILE' that no block came to write
 
     @property
     def ok(self) -> bool:

@@ -119,6 +119,7 @@ def run(script: Script, options: RunOptions) -> RunResult:
                 [float(x) for x in robot.data.qpos],
                 settings.disturb,
                 tuple(hooks.saved) if hooks is not None else (),
+                hooks.unsaved if hooks is not None else None,
             )
             log.write("summary", **result.as_record())
             return result

@@ -16,6 +16,8 @@ from __future__ import annotations
 import base64
 import hashlib
 import json
+import os
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -25,7 +27,7 @@ import numpy as np
 
 from dial.backend.driver import MujocoRobot
 from dial.errors import DialError
-from dial.parser.script import Script, Step, TBlock, TCall, TIf, TRepeat
+from dial.parser.script import Script, Step, TBlock, TCall, TIf, TRepeat, scripts_of
 from dial.primitives import Context
 from dial.primitives.context import StopContact
 from dial.scheduler.position import Frame, Resume
@@ -84,15 +86,36 @@ def _stop_point(text: str | None) -> np.ndarray | None:
     return None if text is None else _floats(text, 3, "a stop's contact point")
 
 
+def _flags(values: list[Any], n: int, what: str) -> np.ndarray:
+    if not isinstance(values, list) or len(values) != n:
+        raise ValueError(f"{what} has not {n} flags")
+    return np.array(values, dtype=bool)
+
+
+def _key(top: Script, path: str) -> str:
+    """A script's path relative to the top script's folder, as a called script is found: the
+    same whatever the working directory and however the top script was named."""
+    base = os.path.dirname(os.path.abspath(top.path))
+    try:
+        return Path(os.path.relpath(os.path.abspath(path), base)).as_posix()
+    except ValueError:  # another drive (Windows)
+        return path
+
+
 def _digest(line: str) -> str:
     return hashlib.sha256(line.encode("utf-8")).hexdigest()[:16]
 
 
-def position_lines(script: Script, path: TimelinePath) -> list[tuple[Script, int]]:
+def position_lines(
+    script: Script, path: TimelinePath, enter: Callable[[Script, int], None] | None = None
+) -> list[tuple[Script, int]]:
     """(script, line) of the saved position in every script the path passes through: the
-    line of the step the walk is at in that script (a ``@call``'s, or the block's)."""
+    line of the step the walk is at in that script (a ``@call``'s, or the block's).
+    ``enter(script, level)`` is called as the walk enters each script, before walking it."""
     out: list[tuple[Script, int]] = []
     steps: tuple[Step, ...] = script.timeline
+    if enter is not None:
+        enter(script, 0)
     try:
         for frame in path:
             step = steps[frame.step]
@@ -107,6 +130,8 @@ def position_lines(script: Script, path: TimelinePath) -> list[tuple[Script, int
             elif isinstance(step, TCall):
                 out.append((script, step.line))
                 script, steps = step.script, step.script.timeline
+                if enter is not None:
+                    enter(script, len(out))
             else:
                 break
     except IndexError:
@@ -120,7 +145,7 @@ def fingerprint(script: Script, path: TimelinePath) -> list[dict[str, Any]]:
     for owner, line in position_lines(script, path):
         lines = Path(owner.path).read_text(encoding="utf-8").split("\n")
         digests = [_digest(text) for text in lines[: line - 1]]
-        prints.append({"file": owner.path, "line": line, "digests": digests})
+        prints.append({"file": _key(script, owner.path), "line": line, "digests": digests})
     return prints
 
 
@@ -152,11 +177,12 @@ def save(
             "disturb": list(settings.disturb),
         },
         "clock": {"periods": loop.periods, "clock": loop.clock, "tick": loop.tick},
-        "latest": [[s, e, o.value] for (s, e), o in loop.latest.items()],
+        "latest": [[_key(script, s), e, o.value] for (s, e), o in loop.latest.items()],
         "counts": dict(loop.counts),
         "contacts": ctx.point_sets,
         "stops": {str(f): [_point(c.tactile), _point(c.link)] for f, c in ctx.stops.items()},
         "results": ctx.results,
+        "believed": {body: _array(pos) for body, (pos, _) in ctx.believed.items()},
         "robot": {
             "steps": robot.steps,
             "arm_target": _array(robot.arm_target),
@@ -186,6 +212,12 @@ class Saved:
         """The runner's resume point, if ``script`` is the saved one with every line before
         the saved position unchanged; else a :class:`StateFileError` naming the first
         changed line as FILE:LINE:COL."""
+        try:
+            return self._check(script)
+        except (KeyError, TypeError, ValueError) as e:  # fields of the wrong shape
+            raise StateFileError(f"state file '{self.source}' is corrupt ({e})") from None
+
+    def _check(self, script: Script) -> Resume:
         d = self.data
         name = Path(script.path).name
         if d["script"] != name:
@@ -194,14 +226,21 @@ class Saved:
             )
         path = tuple(Frame(*f) for f in d["path"])
         prints = d["fingerprint"]
-        for k, saved in enumerate(prints):  # lines before the position: unchanged?
-            self._unchanged(Path(script.path) if k == 0 else Path(saved["file"]), saved)
-        where = position_lines(script, path)
+
+        def enter(owner: Script, level: int) -> None:  # lines before the position: unchanged?
+            if level < len(prints):  # the file the script calls now, wherever it is run from
+                self._unchanged(Path(owner.path), prints[level])
+
+        where = position_lines(script, path, enter)
         if [line for _, line in where] != [p["line"] for p in prints]:
             owner, line = where[-1]
             raise StateFileError(f"{owner.path}:{line}:1: the saved block is no longer here")
         clock = d["clock"]
-        latest = {(s, e): Outcome(o) for s, e, o in d["latest"]}
+        # Outcomes by script as the runner keys them: this run's path of each script (a file
+        # saved before paths were relative to the top script's folder holds them as run).
+        paths = {_key(script, s.path): s.path for s in scripts_of(script)}
+        paths.update({s.path: s.path for s in scripts_of(script)})
+        latest = {(paths.get(s, s), e): Outcome(o) for s, e, o in d["latest"]}
         return Resume(
             path,
             d["block"] - 1,
@@ -250,14 +289,18 @@ class Saved:
         robot.steps = int(r["steps"])
         robot.arm_target = _floats(r["arm_target"], 6, "arm_target")
         robot.hand_target = _floats(r["hand_target"], 16, "hand_target")
-        robot.limp[:] = np.array(r["limp"], dtype=bool)
+        robot.limp[:] = _flags(r["limp"], robot.limp.size, "limp")
         robot.safety.saturated_since[:] = _floats(r["saturated_since"], 32, "saturated_since")
-        robot.safety.saturation_logged[:] = np.array(r["saturation_logged"], dtype=bool)
+        logged = robot.safety.saturation_logged
+        logged[:] = _flags(r["saturation_logged"], logged.size, "saturation_logged")
         robot.disturbances.resume_at(robot.steps)
         ctx.point_sets.update(d["contacts"])
         for f, (tactile, link) in d.get("stops", {}).items():
             ctx.stops[int(f)] = StopContact(_stop_point(tactile), _stop_point(link))
         ctx.results.update(d["results"])
+        for body, pos in d.get("believed", {}).items():  # as `locate` left them
+            if body in ctx.believed:
+                ctx.believed[body] = (_floats(pos, 3, f"believed {body}"), ctx.believed[body][1])
 
 
 def load(source: Path) -> Saved:
@@ -297,6 +340,8 @@ def load(source: Path) -> Saved:
             data[key]
         for frame in data["path"]:
             Frame(*map(int, frame))
+        if type(data["block"]) is not int or data["block"] < 1:
+            raise ValueError(f"block {data['block']!r}")
     except (KeyError, TypeError, ValueError) as e:
         raise StateFileError(f"state file '{source}' is corrupt or truncated ({e})") from None
     return Saved(source, data, settings)

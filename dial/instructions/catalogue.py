@@ -25,6 +25,7 @@ from dial.instructions.types import (
     Mask,
     MaskPair,
     Name,
+    Names,
     ParamType,
     Quantity,
     mask_fingers,
@@ -341,6 +342,24 @@ INSTRUCTIONS: dict[str, Instruction] = {
             "Append where the finger touches (world frame) to a point set.",
             sensing=True,
             primitive="RecordContact",
+        ),
+        Instruction(
+            "locate",
+            "zero",
+            (
+                ParamSpec(
+                    "location",
+                    Name("location", anchored=True),
+                    positional=True,
+                    doc="where the tool is now, relative to the object found",
+                ),
+                ParamSpec("also", Names("object"), (), doc="objects that moved with it"),
+            ),
+            _none,
+            'locate "LOCATION" [also=OBJECT,...]',
+            "The tool is at LOCATION of its object: shift the object's believed position there.",
+            sensing=True,
+            primitive="Locate",
         ),
         Instruction(
             "fit_plane",

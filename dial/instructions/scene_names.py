@@ -19,13 +19,16 @@ class SceneNames:
     """Names a scene's world file defines.
 
     ``poses`` maps each named hand pose to the 16-bit joint mask it sets
-    (bit ``4*f + j``; a pose that sets every joint has mask ``0xFFFF``).
+    (bit ``4*f + j``; a pose that sets every joint has mask ``0xFFFF``). ``anchored``: the
+    locations that are relative to an object; ``objects``: the object aliases.
     """
 
     name: str
     poses: Mapping[str, int] = field(default_factory=dict)
     locations: frozenset[str] = frozenset()
     programs: frozenset[str] = frozenset()
+    objects: frozenset[str] = frozenset()
+    anchored: frozenset[str] = frozenset()
 
 
 class SceneNotFoundError(DialError, LookupError):

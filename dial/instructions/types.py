@@ -24,7 +24,7 @@ CONTACT_THRESHOLDS: dict[str, tuple[Dimension, str, float]] = {
     "force": ("force", "N", 0.5),
     "position": ("length", "mm", 0.003),
 }
-NameKind = Literal["pose", "location", "program", "set"]
+NameKind = Literal["pose", "location", "program", "set", "object"]
 
 
 class ParamError(ValueError):
@@ -159,9 +159,11 @@ _NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
 
 @dataclass(frozen=True)
 class Name(ParamType):
-    """A name looked up elsewhere: a pose, location or program of the scene, or a point set."""
+    """A name looked up elsewhere: a pose, location, program or object of the scene, or a
+    point set. ``anchored``: a location must be relative to an object (``locate``)."""
 
     kind: NameKind
+    anchored: bool = False
 
     @property
     def expected(self) -> str:  # type: ignore[override]
@@ -171,6 +173,29 @@ class Name(ParamType):
         if not _NAME.match(text):
             raise ParamError(f"expected {self.expected} ([A-Za-z_][A-Za-z0-9_]*), got '{text}'")
         return text
+
+
+@dataclass(frozen=True)
+class Names(ParamType):
+    """Comma-separated names of one kind, each at most once (``lid,pitcher``)."""
+
+    kind: NameKind
+
+    @property
+    def expected(self) -> str:  # type: ignore[override]
+        return f"{self.kind} names separated by commas"
+
+    def parse(self, text: str) -> tuple[str, ...]:
+        names = tuple(text.split(","))
+        for name in names:
+            if not _NAME.match(name):
+                raise ParamError(
+                    f"expected {self.expected} ([A-Za-z_][A-Za-z0-9_]*), got '{shorten(text)}'"
+                )
+        twice = next((n for k, n in enumerate(names) if n in names[:k]), None)
+        if twice is not None:
+            raise ParamError(f"{self.kind} '{twice}' is given twice")
+        return names
 
 
 class Conditions(ParamType):

@@ -18,7 +18,7 @@ from pathlib import Path
 from dial.errors import Diagnostic, ScriptError, Span
 from dial.instructions.catalogue import INSTRUCTIONS, Instruction
 from dial.instructions.scene_names import SceneLoader, SceneNames, SceneNotFoundError
-from dial.instructions.types import EFFECTORS, Name
+from dial.instructions.types import EFFECTORS, Name, Names
 from dial.parser.ast import Call, Condition, Definition, ExecLine, Program
 from dial.parser.bind import bind
 from dial.parser.compile import compile_body, diagram_events
@@ -167,27 +167,41 @@ class _Checker:
         specs = instr.verbs.get(str(args.get("verb")), ()) + instr.params
         for spec in specs:
             value = args.get(spec.name)
-            if not isinstance(spec.type, Name) or value is None or spec.name not in spans:
+            if not isinstance(spec.type, Name | Names) or value is None or spec.name not in spans:
                 continue
-            kind = spec.type.kind
-            known: list[str]
-            if kind == "pose":
-                known = list(self.scene.poses)
-            elif kind == "location":
-                known = list(self.scene.locations)
-            elif kind == "program":
-                known = list(self.scene.programs)
-            else:
-                continue
-            if spec.name == "save" or value in known:
-                continue  # limp save= names a new pose
-            ok = False
-            self.error(
-                spans[spec.name],
-                f"event '{event}': unknown {kind} '{value}' in scene '{self.scene.name}'"
-                f"{self.written_for()}{_hint(str(value), known)}{_choices(known)}",
-            )
+            if spec.name == "save" or spec.type.kind == "set":
+                continue  # limp save= names a new pose; point sets are the script's own
+            known = self.known(spec.type)
+            names = value if isinstance(value, tuple) else (value,)
+            for name in (str(n) for n in names if n not in known):
+                ok = False
+                self.error(spans[spec.name], self.unknown(event, spec.type, name, known))
         return ok
+
+    def known(self, kind: Name | Names) -> list[str]:
+        """The scene's names that a parameter of this type may take."""
+        assert self.scene is not None
+        if isinstance(kind, Name) and kind.anchored:
+            return sorted(self.scene.anchored)
+        names = {
+            "pose": self.scene.poses,
+            "location": self.scene.locations,
+            "program": self.scene.programs,
+            "object": self.scene.objects,
+        }
+        return list(names[kind.kind])
+
+    def unknown(self, event: str, kind: Name | Names, name: str, known: list[str]) -> str:
+        assert self.scene is not None
+        if isinstance(kind, Name) and kind.anchored and name in self.scene.locations:
+            return (
+                f"event '{event}': location '{name}' is not relative to an object (those "
+                f"relative to one in scene '{self.scene.name}': {', '.join(known) or 'none'})"
+            )
+        return (
+            f"event '{event}': unknown {kind.kind} '{name}' in scene '{self.scene.name}'"
+            f"{self.written_for()}{_hint(name, known)}{_choices(known)}"
+        )
 
     def written_for(self) -> str:
         """For a called script written for another scene: why its names are looked up here."""

@@ -7,7 +7,7 @@ timeline.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
@@ -144,3 +144,30 @@ class Script:
     @property
     def tick(self) -> float | None:
         return self.program.tick
+
+
+def scripts_of(top: Script) -> list[Script]:
+    """``top`` and every script it calls, directly or through others, each once (by path)."""
+    found: dict[str, Script] = {}
+    todo = [top]
+    while todo:
+        script = todo.pop()
+        if script.path not in found:
+            found[script.path] = script
+            todo += [s.script for s in iter_steps(script.timeline) if isinstance(s, TCall)]
+    return list(found.values())
+
+
+def iter_steps(steps: tuple[Step, ...]) -> Iterator[Step]:
+    """Every step of ``steps`` and of the bodies in them (loops, branches, reactions), in
+    file order, a block before its reactions; not into called scripts."""
+    for step in steps:
+        yield step
+        if isinstance(step, TBlock):
+            for on in step.reactions:
+                yield from iter_steps(on.body)
+        elif isinstance(step, TRepeat):
+            yield from iter_steps(step.body)
+        elif isinstance(step, TIf):
+            yield from iter_steps(step.then)
+            yield from iter_steps(step.orelse)

@@ -21,6 +21,7 @@ from dial.parser.script import (
     TResume,
     TRetry,
     Watch,
+    iter_steps,
 )
 
 
@@ -261,13 +262,4 @@ def expand(script: Script) -> Layout:
 
 def iter_blocks(steps: tuple[Step, ...]) -> Iterator[TBlock]:
     """Every block of ``steps``, in file order, reactions included (not into calls)."""
-    for step in steps:
-        if isinstance(step, TBlock):
-            yield step
-            for r in step.reactions:
-                yield from iter_blocks(r.body)
-        elif isinstance(step, TRepeat):
-            yield from iter_blocks(step.body)
-        elif isinstance(step, TIf):
-            yield from iter_blocks(step.then)
-            yield from iter_blocks(step.orelse)
+    return (step for step in iter_steps(steps) if isinstance(step, TBlock))

@@ -14,7 +14,7 @@ from dial.primitives.arm import ArmMove, PumaCommand
 from dial.primitives.context import Context
 from dial.primitives.guarded import GuardedMove
 from dial.primitives.hand import FingerMove, GraspForce, HandPose, Limp
-from dial.primitives.sensing import ContactWait, Fit, Get, RecordContact
+from dial.primitives.sensing import ContactWait, Fit, Get, Locate, RecordContact
 from dial.scheduler.types import Ended, Primitive, PrimitiveFactory, RunInfo, Sensor
 
 Made = Primitive[Snapshot] | Sensor[Snapshot]
@@ -31,6 +31,7 @@ CLASSES: dict[str, Callable[[Context, RunInfo], Made]] = {
         GuardedMove,
         HandPose,
         Limp,
+        Locate,
         PumaCommand,
         RecordContact,
     )

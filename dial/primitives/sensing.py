@@ -114,6 +114,38 @@ class RecordContact:
         return link_point(robot.model, robot.data, finger_bodies(robot.model, self.finger))
 
 
+class Locate:
+    """``locate "LOCATION" [also=OBJECT,...]``: the tool is at LOCATION of the true object.
+
+    The object's believed position (and that of every ``also`` object) shifts by the tool's
+    commanded position minus LOCATION's believed one, so that LOCATION and every other
+    location relative to these objects follow what touch found. The commanded pose is where
+    the planner starts the next motion from, the same frame the locations are reached in;
+    the believed orientations are kept.
+    """
+
+    def __init__(self, ctx: Context, info: RunInfo) -> None:
+        self.ctx = ctx
+        self.location = str(info.event.args["location"])
+        also = info.event.args["also"]
+        assert isinstance(also, tuple)
+        self.also = tuple(str(a) for a in also)
+
+    def sense(self, snapshot: Snapshot) -> Ended:
+        world = self.ctx.world
+        body = world.locations[self.location].body
+        if body is None:  # the checker refuses this when the scene is known
+            return Ended(Outcome.ERROR, f"location '{self.location}' is not relative to an object")
+        tool, _ = self.ctx.arm_ik.fk(snapshot.arm_target)
+        shift = tool - self.ctx.location(self.location)[0]
+        aliases = {b: a for a, b in world.objects.items()}
+        bodies = dict.fromkeys([body, *(world.objects[a] for a in self.also)])
+        for b in bodies:
+            pos, rot = self.ctx.believed[b]
+            self.ctx.believed[b] = (pos + shift, rot)
+        return done(shift=shift, objects=[aliases.get(b, b) for b in bodies])
+
+
 class Fit:
     """``fit_plane SET`` and ``fit_superquadric SET``: least squares over a point set."""
 

@@ -20,14 +20,15 @@ from dial.recording.observers import object_bodies
 VIEWER_HZ = 60.0  # screen updates per second of simulated (here also wall-clock) time
 
 
-def require_display(flag: str) -> None:
-    """Raise a one-line :class:`DialError` where a window cannot open (no X11 or Wayland)."""
+def require_display(flag: str, instead: str = "--record FILE.rrd or --video FILE.mp4") -> None:
+    """Raise a one-line :class:`DialError` where a window cannot open (no X11 or Wayland);
+    ``instead``: the command's options that need no display."""
     if sys.platform.startswith("linux") and not (
         os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")
     ):
         raise DialError(
             f"{flag} needs a display, and neither DISPLAY nor WAYLAND_DISPLAY is set; "
-            "use --record FILE.rrd or --video FILE.mp4 instead"
+            f"use {instead} instead"
         )
 
 

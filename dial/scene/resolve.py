@@ -54,16 +54,17 @@ def resolve_scene(scene: str, base_dir: Path) -> Path:
     )
 
 
-def scene_option(arg: str) -> str:
+def scene_option(arg: str, option: str = "--scene") -> str:
     """``--scene`` as every script it reaches should see it: an existing world file (as an
     absolute path, so that it means the same from every called script) or a bundled name.
-    Raises :class:`SceneNotFoundError` listing the bundled names."""
+    Raises :class:`SceneNotFoundError` listing the bundled names; ``option`` names the
+    argument in it."""
     if Path(arg).is_file():
         return str(Path(arg).resolve())
     names = bundled_scene_names()
     if arg not in names:
         raise SceneNotFoundError(
-            f"--scene: '{arg}' is neither a file nor a bundled scene; "
+            f"{option}: '{arg}' is neither a file nor a bundled scene; "
             f"bundled scenes: {', '.join(names)}"
         )
     return arg

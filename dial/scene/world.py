@@ -100,6 +100,8 @@ class World:
             poses={name: pose.mask for name, pose in self.poses.items()},
             locations=frozenset(self.locations),
             programs=frozenset(self.programs),
+            objects=frozenset(self.objects),
+            anchored=frozenset(n for n, loc in self.locations.items() if loc.body is not None),
         )
 
 

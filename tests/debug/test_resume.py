@@ -5,25 +5,15 @@ from __future__ import annotations
 
 import json
 import shutil
+from collections.abc import Callable
 from pathlib import Path
 
 import pytest
 
 import dial
 from dial.cli import main
-from dial.engine import RunResult
 
-from ..conftest import ROOT
-
-
-def _records(result: RunResult) -> list[dict[str, object]]:
-    """The log as JSON text would hold it, without the summary's wall time."""
-    out = []
-    for record in result.log.records:
-        record = json.loads(json.dumps(record))
-        record.pop("wall_time", None)
-        out.append(record)
-    return out
+from ..conftest import ROOT, json_records
 
 
 def _check_exact(script: str, scene: str | None, block: int, tmp_path: Path) -> None:
@@ -31,11 +21,11 @@ def _check_exact(script: str, scene: str | None, block: int, tmp_path: Path) -> 
     full = dial.run(dial.load(script, scene=scene), save_at=(block, state))
     assert full.saved == ((block, state),), "the save point was never reached"
     resumed = dial.run(dial.load(script, scene=scene), resume=state)
-    tail = [r for r in _records(resumed) if r["kind"] not in ("scene", "resume")]
-    assert tail == _records(full)[-len(tail) :]
+    tail = [r for r in json_records(resumed) if r["kind"] not in ("scene", "resume")]
+    assert tail == json_records(full)[-len(tail) :]
     assert resumed.final_qpos == full.final_qpos  # bit for bit
     assert resumed.ok == full.ok and resumed.summary.sim_time == full.summary.sim_time
-    assert len(tail) < len(_records(full)) - 2  # it did not simply run everything again
+    assert len(tail) < len(json_records(full)) - 2  # it did not simply run everything again
 
 
 @pytest.mark.parametrize(
@@ -80,6 +70,20 @@ def test_resuming_an_edited_later_block_runs_the_edit(
     assert ends and ends[-1]["outcome"] == "done"
 
 
+def test_a_resumed_summary_times_the_resumed_part(
+    saved: tuple[Path, Path], capsys: pytest.CaptureFixture[str]
+) -> None:
+    script, state = saved
+    main(["run", str(script), "--resume", str(state)])
+    line = next(x for x in capsys.readouterr().out.splitlines() if x.startswith("simulated "))
+    total, rest = line.removeprefix("simulated ").split(" s (", 1)
+    part, rest = rest.split(" s after resuming at ", 1)
+    since, rest = rest.split(" s) in ", 1)
+    assert rest.split(" s wall (real-time factor ", 1)[1]  # counted over the part
+    assert float(part) == pytest.approx(float(total) - float(since), abs=0.011)
+    assert float(since) > 30  # lightbulb's block 12 starts at 30.56 s
+
+
 def test_an_edited_earlier_line_is_named(
     saved: tuple[Path, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -94,6 +98,20 @@ def test_an_edited_earlier_line_is_named(
     assert err.count("\n") == 1 and "Traceback" not in err
 
 
+def _set(field: str, key: str | int | None, value: object) -> Callable[[str], str]:
+    """A damage: the state file's text with ``data[field][key]`` (or ``data[field]``) set."""
+
+    def damage(text: str) -> str:
+        data = json.loads(text)
+        if key is None:
+            data[field] = value
+        else:
+            data[field][key] = value
+        return json.dumps(data)
+
+    return damage
+
+
 @pytest.mark.parametrize(
     ("damage", "message"),
     [
@@ -102,6 +120,11 @@ def test_an_edited_earlier_line_is_named(
         (lambda s: s.replace('"counts"', '"countz"'), "is corrupt or truncated ('counts')"),
         (lambda s: "\x00\x01binary", "is corrupt or truncated (not JSON)"),
         (lambda s: "[1, 2]", "is not a dial state file"),
+        # Valid JSON with a field of the wrong type or size (was a traceback, or a broadcast).
+        (_set("block", None, "12"), "is corrupt or truncated (block '12')"),
+        (_set("robot", "limp", [True]), "is corrupt (limp has not 16 flags)"),
+        (_set("latest", 0, ["lightbulb.dial", "lower", "bogus"]), "is not a valid Outcome"),
+        (_set("clock", None, [1, 2, 3]), "is corrupt ("),
     ],
 )
 def test_a_bad_state_file_is_one_line_and_exit_1(
@@ -154,3 +177,59 @@ def test_a_save_point_never_reached_is_an_error(
     state = tmp_path / "x.state"
     assert main(["run", "reactions.dial", "--save-at", "block:9", str(state), "--quiet"]) == 1
     assert "nothing was saved" in capsys.readouterr().err and not state.exists()
+
+
+TOP = """\
+@scene surface
+@tick 0.1
+% to     puma_command "ex to_block"
+% back   arm_move     0 0 0.01 frame=world
+
+to     #==
+@call sub.dial
+@if to
+back   #=
+@end
+"""
+SUB = """\
+@scene surface
+@tick 0.1
+% open   hand_pose    "open_hand"
+% down   arm_move     0 0 -0.01 frame=world
+
+open   #
+
+down   #=
+@if open
+down   #=
+@end
+"""
+
+
+def test_resume_from_another_directory(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Saved inside a called script run as ``dial run top.dial`` from its folder, resumed by
+    another path from elsewhere: the callee is checked where the script calls it now, and the
+    outcomes of both scripts before the save (which conditions read) carry over."""
+    folder, elsewhere = tmp_path / "scripts", tmp_path / "elsewhere"
+    folder.mkdir()
+    elsewhere.mkdir()
+    (folder / "top.dial").write_text(TOP)
+    (folder / "sub.dial").write_text(SUB)
+    state = folder / "sub.state"
+    monkeypatch.chdir(folder)
+    full = dial.run(dial.load("top.dial"), save_at=(3, state))  # block 3: sub's first down
+    assert full.saved == ((3, state),)
+    monkeypatch.chdir(elsewhere)
+    resumed = dial.run(dial.load(folder / "top.dial"), resume=state)
+
+    def named(records: list[dict[str, object]]) -> list[dict[str, object]]:
+        # A called script's records name it by its path as run: the same file here.
+        return [
+            {**r, **({"script": Path(str(r["script"])).name} if "script" in r else {})}
+            for r in records
+        ]
+
+    tail = named([r for r in json_records(resumed) if r["kind"] not in ("scene", "resume")])
+    assert len(tail) > 4 and tail == named(json_records(full))[-len(tail) :]
+    assert [r["value"] for r in resumed.log.of("condition")] == [True, True]
+    assert resumed.final_qpos == full.final_qpos

@@ -6,16 +6,14 @@ envelope). tests/scenarios runs it at the default tick without perturbation.
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
-from typing import Any
 
 import pytest
 
 import dial
-from dial.cli import main
 
 from ..conftest import ROOT
+from .recovery import check_recovery, ended
 
 SCRIPT = ROOT / "scripts" / "lightbulb.dial"
 # The documented push: the thumb's fingertip pushed 5 N towards the glass for 0.5 s while the
@@ -24,14 +22,10 @@ PUSH = "push body=hand_thumb_distal force=0,5,0 at=1.6 for=0.5"
 HELD = {"bulb_out": True, "bulb_held": True}
 
 
-def _ended(result: dial.RunResult, event: str) -> list[dict[str, Any]]:
-    return [r for r in result.log.of("end") if r["event"] == event]
-
-
 def _unscrewed_by_sensing(result: dial.RunResult, exact: bool = True) -> int:
     """Check the loop ended on a tug that came free after the thread let go (``exact``: in
     the twist just before it, no stroke wasted); return the number of strokes."""
-    tugs = _ended(result, "tug")
+    tugs = ended(result, "tug")
     assert [r["outcome"] for r in tugs[:-1]] == ["done"] * (len(tugs) - 1)
     assert tugs[-1]["outcome"] == "missed"  # the bulb came up with the hand
     assert all(r["data"]["kind"] == "force" for r in tugs[:-1])
@@ -51,7 +45,7 @@ def test_lightbulb_comes_out_held_when_20mm_off() -> None:
     assert result.ok, result.error
     assert result.success == HELD, result.details
     assert not result.log.of("monitor")  # the way down touched nothing
-    feels = _ended(result, "feel_glass")
+    feels = ended(result, "feel_glass")
     assert [(r["outcome"], r["data"]["kind"], r["data"]["finger"]) for r in feels] == [
         ("done", "force", "thumb")
     ] * 2
@@ -71,7 +65,7 @@ def test_a_longer_thread_takes_more_strokes_and_the_hand_follows_it_up() -> None
     result = dial.run(SCRIPT, scene="lightbulb_long", perturb=10, seed=12)
     assert result.ok and result.success == HELD, (result.error, result.details)
     assert 8 <= _unscrewed_by_sensing(result) <= 11  # 3.5 turns
-    assert len(_ended(result, "follow")) == len(_ended(result, "tug")) - 1
+    assert len(ended(result, "follow")) == len(ended(result, "tug")) - 1
 
 
 def test_a_world_file_sets_the_turns_of_another_bulb(tmp_path: Path) -> None:
@@ -85,21 +79,7 @@ def test_a_world_file_sets_the_turns_of_another_bulb(tmp_path: Path) -> None:
 def test_a_push_on_the_way_down_is_met_by_the_reaction(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    log = tmp_path / "run.jsonl"
-    status = main(["run", str(SCRIPT), "--disturb", PUSH, "--log", str(log), "--json", "--quiet"])
-    summary = json.loads(capsys.readouterr().out.splitlines()[-1])
-    assert status == 0 and summary["ok"] is True, summary["error"]
-    records = [json.loads(line) for line in log.read_text().splitlines()]
-    kinds = [(r["kind"], r.get("event") or r.get("what")) for r in records]
-    pushed = kinds.index(("disturb", PUSH))
-    fired = kinds.index(("monitor", "bump_thumb"))
-    assert pushed < fired  # the thumb felt the push on the way down
-    after = [(k, e, r.get("outcome")) for (k, e), r in zip(kinds, records, strict=True)][fired:]
-    assert after[1] == ("end", "lower", "preempted")  # stopped where it was
-    started = [e for k, e, _ in after if k == "start"]
-    assert started[0] == "back_off"  # the reaction's first run
-    again = after.index(("start", "lower", None))
-    assert ("end", "lower", "done") in after[again:]  # the retried descent went down
+    summary = check_recovery(SCRIPT, PUSH, "bump_thumb", "lower", "back_off", tmp_path, capsys)
     assert summary["success"] == HELD
 
 

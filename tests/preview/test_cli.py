@@ -24,7 +24,10 @@ def dial(*args: str) -> subprocess.CompletedProcess[str]:
 def test_pour_passes(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["preview", "pour.dial"]) == 0
     out = capsys.readouterr().out
-    assert out == "pour.dial: preview OK: 1 block, 13 arm targets, 6 hand targets\n"
+    assert out == (
+        "pour.dial: preview OK: 15 blocks, 21 arm targets, 6 hand targets"
+        " (2 @on reactions, 7 loops once each)\n"
+    )
 
 
 def test_a_location_moved_out_of_reach_fails_naming_it_and_its_line(
@@ -33,7 +36,7 @@ def test_a_location_moved_out_of_reach_fails_naming_it_and_its_line(
     far = tmp_path / "far.toml"
     far.write_text(
         'extends = "pour"\n\n[locations]\n'
-        "lid_grasp = { pos = [2.5, 0, 0.6], rpy = [0, 180, 0] }  # far beyond the table\n"
+        'lid_grasp = { object = "lid", pos = [1.9, 0, 0.121], rpy = [0, 180, 0] }  # far away\n'
     )
     assert main(["preview", "pour.dial", "--scene", str(far)]) == 1
     lines = capsys.readouterr().out.splitlines()
@@ -43,7 +46,7 @@ def test_a_location_moved_out_of_reach_fails_naming_it_and_its_line(
     path, line, col = place.rsplit(":", 2)
     assert event == "get_top"
     assert Path(path).read_text().splitlines()[int(line) - 1][int(col) - 1 :].startswith("#====")
-    assert lines[-1].startswith("pour.dial: 3 problems: ")
+    assert lines[-1].startswith("pour.dial: 6 problems: ")
 
 
 def test_notes_are_printed_on_request(capsys: pytest.CaptureFixture[str]) -> None:

@@ -69,12 +69,16 @@ def edge(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, list[str], lis
 def test_pour_previews_clean() -> None:
     result = preview(load("pour.dial"))
     assert result.ok and result.problems == [] and result.notes == []
-    assert result.summary() == "pour.dial: preview OK: 1 block, 13 arm targets, 6 hand targets"
+    assert result.summary() == (
+        "pour.dial: preview OK: 15 blocks, 21 arm targets, 6 hand targets"
+        " (2 @on reactions, 7 loops once each)"
+    )
 
 
 def test_a_location_out_of_reach_is_named_at_the_line_that_uses_it(tmp_path: Path) -> None:
     (tmp_path / "far.toml").write_text(
-        'extends = "pour"\n[locations]\nlid_grasp = { pos = [2.5, 0, 0.6], rpy = [0, 180, 0] }\n'
+        'extends = "pour"\n[locations]\n'
+        'lid_grasp = { object = "lid", pos = [1.9, 0, 0.121], rpy = [0, 180, 0] }\n'
     )
     script = load("pour.dial", scene=str(tmp_path / "far.toml"))
     result = preview(script)

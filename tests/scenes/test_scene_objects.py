@@ -28,7 +28,7 @@ def _in_site(model: mujoco.MjModel, data: mujoco.MjData, bodies: list[str], site
 
 # Pour -------------------------------------------------------------------------------------
 
-GRIP = '<body name="grip" mocap="true" pos="0.55 -0.12 0.35"/>'
+GRIP = '<body name="grip" mocap="true" pos="0.59 -0.12 0.35"/>'
 WELD = '<weld body1="grip" body2="pour_pitcher"/>'
 
 

@@ -22,7 +22,7 @@ DIAL = [sys.executable, "-m", "dial.cli"]
 SESSION = """\
 # Teach a pinch on the lid's knob, from the start pose (home).
 pose open_hand
-jog 200 -120 -100      # over the pitcher, 80 mm above the knob
+jog 240 -120 -100      # over the pitcher, 80 mm above the knob
 jog z -79              # down beside the knob
 save location knob_grip relative-to pitcher
 finger middle mcp 15   # close middle and thumb onto the knob
@@ -32,8 +32,8 @@ save pose knob_pinch fingers=0xF0F0
 write
 """
 
-# scripts/pour.dial with the lid taken at the taught location, closing to the taught pose
-# before the grasp with force.
+# The paper's pour (scripts/pour.dial without its feeling and its watch) with the lid taken at
+# the taught location, closing to the taught pose before the grasp with force.
 SCRIPT = """\
 @scene taught.toml
 @tick 0.25
@@ -49,6 +49,7 @@ SCRIPT = """\
 % grabpit     grasp_force  "0x6060_0x2020 40N"
 % pourpit     puma_command "ex pour"
 % retract_arm puma_command "ex retract_arm"
+% lower_pit   puma_command "moves pitcher_grasp"
 
 approach    #========
 descend              #===
@@ -57,10 +58,11 @@ pinch                    #
 grab_top                  #
 lift_top                   #=========
 to_grasp                                 #======
-prepit                                   #------         #---
-grabpit                                         #
-pourpit                                          #=======
-retract_arm                                                  #=====
+lower_pit                                       #==
+prepit                                   #------            #---
+grabpit                                            #
+pourpit                                             #=======
+retract_arm                                                     #=====
 """
 
 
@@ -77,7 +79,7 @@ def test_a_scripted_session_teaches_names_that_a_new_script_runs_with(tmp_path: 
     done = dial("teach", "--scene", "pour", "--into", str(taught), stdin=SESSION)
     assert done.returncode == 0, done.stdout + done.stderr
     echo = "teach> jog z -79              # down beside the knob\n"
-    assert echo + "tool  pos [550.0, -120.0, 621.0]" in done.stdout
+    assert echo + "tool  pos [590.0, -120.0, 621.0]" in done.stdout
     assert f"wrote knob_grip, knob_pinch to {taught}" in done.stdout
     world = load_world(taught)
     grip = world.locations["knob_grip"]
@@ -173,6 +175,7 @@ def test_viewer_without_a_display_is_one_line(tmp_path: Path) -> None:
     done = dial("teach", "--scene", "pour", "--viewer")
     assert done.returncode == 1
     assert done.stderr.startswith("dial: --viewer needs a display")
+    assert done.stderr.endswith("; use --snapshot DIR instead\n")  # not dial run's --record
     assert "Traceback" not in done.stderr
     assert len(done.stderr.strip().splitlines()) == 1
 
@@ -180,6 +183,8 @@ def test_viewer_without_a_display_is_one_line(tmp_path: Path) -> None:
 def test_usage_errors_exit_2(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["teach", "--scene", "nowhere"]) == 2
     assert "--scene: 'nowhere' is neither a file nor a bundled scene" in capsys.readouterr().err
+    assert main(["world", "nowhere"]) == 2
+    assert capsys.readouterr().err.startswith("dial: SCENE: 'nowhere' is neither a file")
     assert main(["world", "pour", "--picture", "x.jpg"]) == 2
     assert "--picture writes a .png file" in capsys.readouterr().err
     assert main(["teach", "--scene", "pour", "--viewer", "--snapshot", "d"]) == 2
@@ -196,15 +201,15 @@ def test_teach_help_lists_every_command(capsys: pytest.CaptureFixture[str]) -> N
 def test_world_lists_the_scene(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["world", "pour"]) == 0
     out = capsys.readouterr().out
-    assert "  pitcher  pour_pitcher  pos [550.0, -120.0, 350.0]  rpy [0.0, 0.0, 0.0]" in out
+    assert "  pitcher  pour_pitcher  pos [590.0, -120.0, 350.0]  rpy [0.0, 0.0, 0.0]" in out
     assert "  open_hand   0xFFFF  index [0, 5, 5, 5]  middle [0, 5, 5, 5]" in out
     assert "  unscrew     0x1111  index {abd -15}" in out
     line = next(x for x in out.splitlines() if x.startswith("  pitcher_grasp "))
-    assert "pos [445.0, -120.0, 440.0]  rpy [0.0, 90.0, 0.0]" in line
-    assert line.endswith("relative to pitcher: pos [-105.0, 0.0, 90.0] rpy [0.0, 90.0, 0.0]")
+    assert "pos [480.0, -120.0, 440.0]  rpy [0.0, 90.0, 0.0]" in line
+    assert line.endswith("relative to pitcher: pos [-110.0, 0.0, 90.0] rpy [0.0, 90.0, 0.0]")
     home = "  home            pos [350.0, 0.0, 800.0]     rpy [0.0, 180.0, 0.0]      absolute"
     assert home in out
-    assert "  to_grasp     DEPART 80mm; MOVE beside_pitcher; MOVES pitcher_above; MOVES" in out
+    assert "  to_grasp     DEPART 80mm; MOVE beside_pitcher; MOVES pitcher_above\n" in out
     assert "  pitcher_upright  upright             object=pour_pitcher max_tilt_deg=10" in out
     assert "thread" not in out
     assert main(["world", "lightbulb_long"]) == 0

@@ -49,7 +49,7 @@ def test_a_change_keeps_every_comment_in_order_and_entries_in_place(
     assert lines[home + 1] == near
     pinch = lines.index("[poses.pinch]")
     assert lines[pinch + 1 : pinch + 4] == ["middle = { mcp = 20 }", "thumb = { mcp = 10 }", ""]
-    assert lines[pinch - 2 : pinch] == ["thumb = [0, -20, 0, 0]", ""]
+    assert lines[pinch - 2 : pinch] == ["thumb = [0, -10, 0, 20]", ""]  # knob_open's
     assert lines[pinch + 4] == "[locations]"
     path.write_text(after, encoding="utf-8")
     world = load_world(path)
@@ -66,7 +66,8 @@ def test_replacing_a_pose_keeps_its_table_and_the_comments_above_it(
     after = render(before, [pose])
     start = before.index("[poses.prepit]")
     assert after[:start] == before[:start]
-    assert after[start:].startswith("[poses.prepit]\nindex = [5, 5, 5, 5]\n\n[locations]")
+    rest = "[poses.prepit]\nindex = [5, 5, 5, 5]\n\n# Wide open over the lid's knob"  # knob_open's
+    assert after[start:].startswith(rest)
 
 
 def test_entries_round_to_what_is_written() -> None:
