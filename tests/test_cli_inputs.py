@@ -3,6 +3,9 @@ status for every case, never a traceback."""
 
 from __future__ import annotations
 
+import os
+import resource
+import signal
 import subprocess
 import sys
 from pathlib import Path
@@ -89,13 +92,28 @@ def test_fmt_of_a_file_it_cannot_rewrite(
 ) -> None:
     path = tmp_path / "x.dial"
     path.write_text("% a  get_joints\na #\n")
-
-    def refuse(self: Path, *args: object, **kwargs: object) -> int:
-        raise PermissionError(13, "Permission denied")
-
-    monkeypatch.setattr(Path, "write_text", refuse)  # as a read-only file would (root or not)
+    monkeypatch.setattr(os, "access", lambda *args: False)  # as a read-only file (root or not)
     assert main(["fmt", str(path)]) == 1
     assert capsys.readouterr().err == f"dial: cannot rewrite {path}: Permission denied\n"
+    assert path.read_text() == "% a  get_joints\na #\n" and os.listdir(tmp_path) == ["x.dial"]
+
+
+def test_fmt_on_a_full_disk_keeps_the_script_whole(tmp_path: Path) -> None:
+    """A file-size limit stands in for a full disk: the rewrite fails part-way through."""
+    path = tmp_path / "x.dial"
+    original = "% a  get_joints\n" + "a #\n" * 2000  # 8 kB, to be re-aligned
+    path.write_text(original)
+
+    def limit() -> None:
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # a write past the limit fails (EFBIG)
+        resource.setrlimit(resource.RLIMIT_FSIZE, (4096, 4096))
+
+    done = subprocess.run(
+        [*DIAL, "fmt", str(path)], capture_output=True, text=True, preexec_fn=limit
+    )
+    assert done.returncode == 1 and "Traceback" not in done.stderr
+    assert done.stderr == f"dial: cannot rewrite {path}: File too large\n"
+    assert path.read_text() == original and os.listdir(tmp_path) == ["x.dial"]
 
 
 def test_an_observer_that_fails_mid_run_stops_it_cleanly(tmp_path: Path) -> None:
@@ -127,3 +145,20 @@ def test_check_of_a_latin1_script(tmp_path: Path, capsys: pytest.CaptureFixture[
     assert main(["check", str(path)]) == 1
     out = capsys.readouterr().out
     assert out.startswith(f"{path}:2:7: not UTF-8 text (byte 0xE9); dial scripts are UTF-8\n")
+
+
+def test_world_of_a_latin1_world_file(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    path = tmp_path / "w.toml"
+    path.write_bytes('extends = "surface"\n# caf\xe9\n'.encode("latin-1"))
+    assert main(["world", str(path)]) == 1
+    assert capsys.readouterr().err == f"dial: {path}: not UTF-8 text (byte 25); TOML is UTF-8\n"
+
+
+def test_teach_snapshot_into_a_folder_it_cannot_make(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    blocker = tmp_path / "file"
+    blocker.write_text("")  # a file where the folder's parent should be
+    assert main(["teach", "--scene", "surface", "--snapshot", str(blocker / "shots")]) == 1
+    err = capsys.readouterr().err
+    assert err == f"dial: --snapshot: cannot make the folder {blocker / 'shots'}: Not a directory\n"

@@ -284,3 +284,19 @@ def test_ctrl_c_stops_the_run_at_a_checkpoint_with_the_arm_held(tick: int) -> No
     start = (tick - 1) * 0.1
     assert start <= last["t"] <= start + 0.011  # at most a period after the signal
     assert not [r for r in log.records if r["kind"] == "end"]  # the arm's move never finished
+
+
+def test_the_log_never_holds_nan_or_inf() -> None:
+    """A non-finite number anywhere in a record is written as null: the log stays strict JSON
+    (issue 15: --perturb nan wrote NaN)."""
+    import io
+    import json
+
+    import numpy as np
+
+    sink = io.StringIO()
+    log = EventLog(sink)
+    log.write("x", a=float("nan"), b=[1.0, float("inf")], c={"d": np.array([-np.inf, 2.5])})
+    line = sink.getvalue()
+    assert line == '{"kind":"x","a":null,"b":[1.0,null],"c":{"d":[null,2.5]}}\n'
+    json.loads(line, parse_constant=lambda c: pytest.fail(f"{c} in the log"))

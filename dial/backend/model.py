@@ -69,12 +69,22 @@ def compiled_count() -> int:
 def load_model(path: str | Path = ROBOT_XML) -> mujoco.MjModel:
     """Compile the robot, or a scene XML file that includes ``utah_hand_puma.xml``."""
     if _compiled is None:
-        return mujoco.MjModel.from_xml_path(str(path), _robot_files())
+        return _compile(path)
     key = (str(path), os.stat(path).st_mtime_ns)
     model = _compiled.get(key)
     if model is None:
-        model = _compiled[key] = mujoco.MjModel.from_xml_path(str(path), _robot_files())
+        model = _compiled[key] = _compile(path)
     return copy.copy(model)
+
+
+def _compile(path: str | Path) -> mujoco.MjModel:
+    # `dial check` reads the XML without MuJoCo (well-formed, bodies named); what only
+    # MuJoCo's compiler finds (a bad attribute value, say) must still reach the user as a line.
+    try:
+        return mujoco.MjModel.from_xml_path(str(path), _robot_files())
+    except ValueError as e:
+        why = "; ".join(line.strip() for line in str(e).splitlines() if line.strip())
+        raise DialError(f"{path}: MuJoCo cannot compile the model: {why}") from None
 
 
 def load_model_from_string(xml: str) -> mujoco.MjModel:

@@ -13,6 +13,7 @@ from collections.abc import Sequence
 
 from dial import __version__
 from dial.cli import preview, replay, run, teach, text, tune
+from dial.cli.common import Terminated
 from dial.errors import DialError, OptionError, ScriptError
 
 EPILOG = """\
@@ -67,6 +68,9 @@ def _main(argv: Sequence[str] | None) -> int:
     except DialError as e:
         print(f"dial: {e}", file=sys.stderr)
         return 1
+    except Terminated:  # SIGTERM in a command that asks for it as an exception (dial tune)
+        print("dial: terminated", file=sys.stderr)
+        return 143
     except KeyboardInterrupt:  # outside a run (which turns signals into a clean stop)
         print("dial: interrupted", file=sys.stderr)
         return 130

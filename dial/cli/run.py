@@ -18,7 +18,8 @@ if TYPE_CHECKING:
 
 DESCRIPTION = (
     "Run a script on the simulated hand and arm. Shows live progress, then each event's "
-    "outcome, the simulated and wall time and the scene's success criteria. Exit 0 when "
+    "outcome, any warnings (a DRIVE stopped at a joint limit, a tendon held at its tension "
+    "limit), the simulated and wall time and the scene's success criteria. Exit 0 when "
     "the run completes and every criterion holds; 1 on a script or run error or a failed "
     "criterion; 2 on a usage error; 130 on SIGINT (Ctrl-C) and 143 on SIGTERM, after every "
     "effector holds and the log ends with 'interrupted' and 'summary'."
@@ -214,6 +215,9 @@ def summary_text(result: RunResult) -> str:
     for r, name in zip(ends, names, strict=True):
         note = f"  {r['message']}" if r.get("message") else ""
         lines.append(f"  tick {r['tick']:4d}  {name:<{width}}  {r['outcome']}{note}")
+    for r in result.log.of("warning"):  # a DRIVE stopped at a limit, a tendon held at its own
+        where = f"tick {r['tick']:4d}" if "tick" in r else f"t={r['t']:.2f} s"
+        lines.append(f"  {where}  warning: {r['message']}")
     for r in result.log.of("monitor"):
         lines.append(
             f"  tick {r['tick']:4d}  monitor '@on {r['condition']}' fired at "

@@ -3,7 +3,11 @@
 from __future__ import annotations
 
 import argparse
+import os
+import stat
 import sys
+import tempfile
+from contextlib import suppress
 from pathlib import Path
 
 from dial.cli.common import load_script, scene_argument
@@ -94,8 +98,31 @@ def cmd_fmt(args: argparse.Namespace) -> int:
             status = 1
         else:
             try:
-                path.write_text(formatted, encoding="utf-8")
+                _rewrite(path, formatted)
             except OSError as e:
                 raise DialError(f"cannot rewrite {arg}: {e.strerror or e}") from None
             print(f"{path}: reformatted")
     return status
+
+
+def _rewrite(path: Path, text: str) -> None:
+    """Replace the file's text whole or not at all: a full disk or a Ctrl-C mid-write must
+    not leave a script cut short. Written beside it, then renamed over it, mode kept; where
+    no file can be made beside it (a read-only folder), written in place."""
+    target = path.resolve()  # through a symlink: the link keeps pointing at the script
+    if not os.access(target, os.W_OK):
+        raise PermissionError(13, "Permission denied")
+    try:
+        fd, temp = tempfile.mkstemp(dir=target.parent, prefix=f".{target.name}.", suffix=".tmp")
+    except OSError:
+        target.write_text(text, encoding="utf-8")
+        return
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as f:
+            f.write(text)
+        os.chmod(temp, stat.S_IMODE(target.stat().st_mode))
+        os.replace(temp, target)
+    except BaseException:
+        with suppress(OSError):
+            os.unlink(temp)
+        raise

@@ -6,7 +6,7 @@ import argparse
 from pathlib import Path
 
 from dial import api
-from dial.cli.common import UsageError, at_least, scene_argument
+from dial.cli.common import UsageError, at_least, scene_argument, sigterm_as_interrupt
 from dial.disturb import parse_disturbance
 from dial.instructions.scene_names import SceneNotFoundError
 
@@ -19,7 +19,8 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         "parallel worker processes or as Ray tasks, and print success rate and task time "
         "per tick length. "
         "Exit 0 when some tick length succeeded in every trial, 1 when none did (or the "
-        "plot could not be written), 2 on a usage error. See docs/tuning.md.",
+        "plot could not be written), 2 on a usage error, 130 on Ctrl-C and 143 on SIGTERM "
+        "(the workers are stopped). See docs/tuning.md.",
     )
     p.add_argument("script", metavar="SCRIPT", help="script path or bundled name")
     scene_argument(p)
@@ -81,6 +82,10 @@ def cmd_tune(args: argparse.Namespace) -> int:
     at_least("--trials", args.trials, 1)
     at_least("--jobs", args.jobs, 1)
     api.check_options(None, 1.0, args.seed, args.perturb)
+    if args.plot is not None:  # a sweep can take hours: say so now, not after it
+        if Path(args.plot).suffix.lower() != ".png":
+            raise UsageError(f"--plot writes a .png file, not '{args.plot}'")
+        api.writable(args.plot, "the plot")
     for spec in args.disturb:  # a bad SPEC is a usage error before anything runs
         parse_disturbance(spec)
     try:
@@ -103,11 +108,13 @@ def cmd_tune(args: argparse.Namespace) -> int:
         if args.address is not None:
             raise UsageError("--address needs --executor ray")
         # spawn: a fork server (preload=models.PRELOAD) measured no faster for one pool
-        return tune(options, ProcessExecutor(args.jobs, initializer=models.install))
+        with sigterm_as_interrupt():  # the workers are stopped, as on Ctrl-C
+            return tune(options, ProcessExecutor(args.jobs, initializer=models.install))
     from dial.tune.ray_executor import RayExecutor, RayUsageError
 
     try:
         executor = RayExecutor(args.address, args.jobs, initializer=models.install)
     except RayUsageError as e:
         raise UsageError(str(e)) from None
-    return tune(options, executor)
+    with sigterm_as_interrupt():
+        return tune(options, executor)

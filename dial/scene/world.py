@@ -361,3 +361,7 @@ def _read_toml(path: Path, referrer: Reader | None) -> dict[str, Any]:
         raise WorldFileError(path, "", "no such file") from None
     except tomllib.TOMLDecodeError as e:
         raise WorldFileError(path, "", f"invalid TOML: {e}") from None
+    except UnicodeDecodeError as e:
+        raise WorldFileError(path, "", f"not UTF-8 text (byte {e.start}); TOML is UTF-8") from None
+    except OSError as e:
+        raise WorldFileError(path, "", f"cannot read it: {e.strerror or e}") from None

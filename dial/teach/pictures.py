@@ -197,7 +197,11 @@ class Snapshots:
     """``dial teach --snapshot DIR``: a PNG of the scene after every command that ran."""
 
     def __init__(self, sim: Sim, directory: Path) -> None:
-        directory.mkdir(parents=True, exist_ok=True)
+        try:
+            directory.mkdir(parents=True, exist_ok=True)
+        except OSError as e:
+            message = f"--snapshot: cannot make the folder {directory}: {e.strerror or e}"
+            raise DialError(message) from None
         self.sim, self.directory, self.count = sim, directory, 0
         bodies = [sim.model.body(b).id for b in sim.world.objects.values()]
         self.renderer = Renderer(sim.model, task_camera(sim.data, bodies))

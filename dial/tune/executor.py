@@ -167,20 +167,43 @@ class ProcessExecutor:
         )
         futures: dict[Future[R], int] = {pool.submit(_call, fn, i, items[i]): i for i in todo}
         try:
-            for future in as_completed(futures):
-                i = futures[future]
-                try:
-                    results[i] = future.result()
-                except BrokenProcessPool as e:
-                    for other, j in futures.items():  # keep what finished before the break
-                        if other.done() and not other.cancelled() and other.exception() is None:
-                            results[j] = other.result()
-                    return str(e) or type(e).__name__
-                except Exception as e:  # fn raised, or an item or result did not pickle
-                    results[i] = lost(items[i], f"{type(e).__name__}: {e}")
-                if progress is not None:
-                    progress(len(results))
-        finally:
-            # On an interrupt, queued items must not start; running ones have had SIGINT too.
-            pool.shutdown(wait=True, cancel_futures=True)
+            broken = self._collect(futures, items, lost, results, progress)
+        except BaseException:  # an interrupt: stop now, so that a second one finds no wait
+            _stop_now(pool)
+            raise
+        pool.shutdown(wait=True, cancel_futures=True)
+        return broken
+
+    @staticmethod
+    def _collect(
+        futures: dict[Future[R], int],
+        items: Sequence[T],
+        lost: Callable[[T, str], R],
+        results: dict[int, R],
+        progress: Progress | None,
+    ) -> str | None:
+        """Gather ``futures`` into ``results``; return why the pool broke, or None."""
+        for future in as_completed(futures):
+            i = futures[future]
+            try:
+                results[i] = future.result()
+            except BrokenProcessPool as e:
+                for other, j in futures.items():  # keep what finished before the break
+                    if other.done() and not other.cancelled() and other.exception() is None:
+                        results[j] = other.result()
+                return str(e) or type(e).__name__
+            except Exception as e:  # fn raised, or an item or result did not pickle
+                results[i] = lost(items[i], f"{type(e).__name__}: {e}")
+            if progress is not None:
+                progress(len(results))
         return None
+
+
+def _stop_now(pool: ProcessPoolExecutor) -> None:
+    """On an interrupt: queued items never start, and the workers are killed, not waited
+    for. A shutdown that waits can itself be cut by a second Ctrl-C, leaving a worker
+    waiting for work that the exit then joins forever (with the CLI ignoring signals)."""
+    workers = list((pool._processes or {}).values())  # the executor has no public handle
+    pool.shutdown(wait=False, cancel_futures=True)
+    for worker in workers:
+        worker.kill()

@@ -6,6 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from dial.parser.parse import MAX_TICK_S
 from dial.units import UnitError, parse_number, parse_quantity
 
 
@@ -43,8 +44,10 @@ def parse_ticks(text: str) -> tuple[float, ...]:
         raise ValueError(f"{e} in '{text}'") from None
     if not (count.is_integer() and count >= 1):
         raise ValueError(f"N must be a whole number of at least 1, got '{parts[2]}'")
-    if not 0 < low <= high:
-        raise ValueError(f"need 0 < A <= B, got A={low:g} s and B={high:g} s")
+    if not 0 < low <= high <= MAX_TICK_S:
+        raise ValueError(
+            f"need 0 < A <= B <= {MAX_TICK_S:g} s (as @tick), got A={low:g} s and B={high:g} s"
+        )
     if count == 1 and low != high:
         raise ValueError("N=1 gives one tick length, so A and B must be equal")
     # Rounding keeps linspace's last-bit noise (0.15000000000000002) out of tables and JSON.

@@ -110,3 +110,22 @@ def test_signals_end_the_run_cleanly_with_a_complete_log(
     assert records[-2]["signal"] == name and records[-1]["interrupted"] == name
     ticks = [r for r in records if r["kind"] == "tick"]
     assert records[-2]["t"] <= ticks[-1]["t1"] + 0.5  # stopped within the tick it was in
+
+
+def test_a_drive_beyond_a_joint_limit_at_run_time_is_a_warning_not_a_silent_done(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # Within joint 3's whole range (270 deg), so check accepts it; from the surface scene's
+    # home the target lies beyond the lower limit: the arm stops there and says so.
+    path = _script(tmp_path, '% d3 puma_command "drive 3 -200"\nd3 #====\n')
+    log = tmp_path / "log.jsonl"
+    main(["run", str(path), "--log", str(log)])
+    message = (
+        "DRIVE 3 -200 (drive): the target -404.6 deg is 179.6 deg beyond joint 3's lower "
+        "limit (-225.0 deg); it stops there"
+    )
+    records = [json.loads(line) for line in log.read_text().splitlines()]
+    (warning,) = [r for r in records if r["kind"] == "warning"]
+    assert (warning["event"], warning["tick"], warning["message"]) == ("d3", 5, message)
+    out = capsys.readouterr().out.splitlines()
+    assert out[1:3] == ["  tick    5  d3     done", f"  tick    5  warning: {message}"]

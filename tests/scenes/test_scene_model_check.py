@@ -56,3 +56,21 @@ def test_an_object_naming_no_body_is_an_error_at_scene(tmp_path: Path) -> None:
         f"{tmp_path / 'w.toml'}: objects.block: no body 'surface_blok' in scene_surface.xml; "
         "did you mean 'surface_block' or 'surface_table'?"
     )
+
+
+def test_a_model_only_mujoco_refuses_is_one_line_at_run_time(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from dial.cli import main
+
+    geom = '<worldbody><geom type="sphere" size="abc" pos="3 3 3"/></worldbody>'
+    write(tmp_path / "scene.xml", f'<mujoco>\n  <include file="{SCENE_XML}"/>\n  {geom}\n</mujoco>')
+    write(tmp_path / "w.toml", 'extends = "surface"\n[scene]\nmodel = "scene.xml"\n')
+    write(tmp_path / "s.dial", "@scene w.toml\n% t get_joints\nt #\n")
+    assert main(["check", str(tmp_path / "s.dial")]) == 0  # well-formed, its bodies are there
+    capsys.readouterr()
+    assert main(["run", str(tmp_path / "s.dial"), "--quiet"]) == 1
+    assert capsys.readouterr().err == (
+        f"dial: {tmp_path / 'scene.xml'}: MuJoCo cannot compile the model: XML Error: bad "
+        "format in attribute 'size'; Element 'geom', line 3\n"
+    )

@@ -17,7 +17,10 @@ from dial.tune.trial import engine_backend, run_trial
 @pytest.mark.parametrize(
     ("args", "message"),
     [
-        (["--ticks", "0.5:0.1:3"], "dial: --ticks: need 0 < A <= B, got A=0.5 s and B=0.1 s"),
+        (
+            ["--ticks", "0.5:0.1:3"],
+            "dial: --ticks: need 0 < A <= B <= 60 s (as @tick), got A=0.5 s and B=0.1 s",
+        ),
         (["--ticks", "0.1:0.5"], "dial: --ticks: expected A:B:N (e.g. 0.05:0.5:10), got"),
         (["--ticks", "0.1:0.5:3", "--trials", "0"], "dial: --trials must be at least 1, got 0"),
         (["--ticks", "0.1:0.5:3", "--jobs", "0"], "dial: --jobs must be at least 1, got 0"),
@@ -27,6 +30,7 @@ from dial.tune.trial import engine_backend, run_trial
             ["--ticks", "0.1:0.5:3", "--disturb", "push body=x"],
             "dial: --disturb 'push body=x': missing at=",
         ),
+        (["--ticks", "0.1:0.5:3", "--plot", "p.txt"], "dial: --plot writes a .png file, not"),
         (
             ["--ticks", "0.1:0.5:3", "--disturb", "push body=nosuch force=1,0,0 at=0 for=1"],
             "dial: --disturb 'push body=nosuch force=1,0,0 at=0 for=1': no body 'nosuch' in "
@@ -54,6 +58,16 @@ def test_a_script_error_stops_the_sweep_before_it_starts(
     bad.write_text("% go hand_pos x\n\ngo #\n")
     assert main(["tune", str(bad), "--ticks", "0.1:0.2:2"]) == 1
     assert "unknown instruction 'hand_pos'" in capsys.readouterr().err
+
+
+def test_an_unwritable_plot_stops_the_sweep_before_it_starts(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    png = tmp_path / "no" / "p.png"
+    assert main(["tune", "lightbulb", "--ticks", "0.1:0.2:2", "--plot", str(png)]) == 1
+    captured = capsys.readouterr()
+    assert captured.err == f"dial: cannot write the plot: no such directory '{png.parent}'\n"
+    assert captured.out == ""  # no trial ran
 
 
 def test_small_lightbulb_sweep_prints_table_json_and_plot(
