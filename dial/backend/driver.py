@@ -73,6 +73,10 @@ class MujocoRobot:
         # writing a slice costs a fraction of writing through an index array.
         self._arm_ctrl = as_slice(ix.arm_actuators)
         self._tendon_ctrl = as_slice(ix.tendon_actuators)
+        # Both tendons of a joint servo to its angle (hand_ctrl): where the 32 controls run
+        # in order, a (16, 2) view of them takes the 16 angles in one broadcast write.
+        tendons = data.ctrl[self._tendon_ctrl]
+        self._tendon_pairs = tendons.reshape(16, 2) if tendons.base is not None else None
         self._finger_bodies = tuple(finger_bodies(model, f) for f in range(len(FINGERS)))
         hand_joints = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, n) for n in HAND_JOINTS]
         self.hand_range = model.jnt_range[hand_joints].copy()  # (16, 2) rad, mask order
@@ -235,7 +239,10 @@ class MujocoRobot:
         target = self.hand_target
         if self.limp.any():  # limp joints follow their measured angle
             target = np.where(self.limp, d.qpos[self.index.hand_qpos], target)
-        d.ctrl[self._tendon_ctrl] = hand_ctrl(target)
+        if self._tendon_pairs is not None:
+            self._tendon_pairs[:] = target[:, None]
+        else:
+            d.ctrl[self._tendon_ctrl] = hand_ctrl(target)
 
     def _check_guards(self) -> None:
         readings = self._readings.at_step(self.hand_target, self.disturbances.dropped)
