@@ -19,7 +19,7 @@ Prints:
 - the scheduler's cost per event run on the fake robot, beside an equivalent py_trees tree
   (needs the `bench` extra: pip install -e ".[bench]").
 
-    python benchmarks/bench_engine.py [SCRIPT] [--runs N] [--repeat K]
+    python benchmarks/bench_engine.py [SCRIPT] [--runs N] [--repeat K] [--scene S]
 """
 
 from __future__ import annotations
@@ -302,7 +302,18 @@ def main() -> None:
     ap.add_argument("script", nargs="?", default="pour.dial")
     ap.add_argument("--runs", type=int, default=4000, help="event runs for the scheduler cost")
     ap.add_argument("--repeat", type=int, default=5, help="timed pairs of a run and a replay")
+    ap.add_argument(
+        "--scene",
+        help="run the script in this scene (a name or a world file; e.g. "
+        "benchmarks/pour_before/pour_before.toml: today's engine on the physics of before)",
+    )
     args = ap.parse_args()
+    if args.scene is not None:
+        path = resolve_script(args.script)
+        scene = str(Path(args.scene).resolve()) if Path(args.scene).exists() else args.scene
+        engine_overhead(load(path, loader=load_scene_names, scene=scene), args.repeat)
+        scheduler_cost(args.runs)
+        return
     world, replay = engine_overhead(args.script, args.repeat)
     if _is_pour(world):
         pour_physics(args.script, replay, args.repeat)
