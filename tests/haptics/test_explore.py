@@ -81,4 +81,4 @@ def test_explore_chooses_and_succeeds_with_the_object_10mm_off(
         tmp_path, "explore.dial", "--scene", scene, "--perturb", "10", "--seed", str(seed)
     )
     assert status == 0, summary["criteria"]
-    assert [r["script"] for r in records if r["kind"] == "call"][0] == called
+    assert next(r["script"] for r in records if r["kind"] == "call") == called
