@@ -157,6 +157,9 @@ class RerunSink:
         poses, ``objects`` the scene's object aliases, ``plan`` the script's event lanes."""
         rec = self.rec
         self.lanes = Lanes(plan)
+        self._at(0.0, 0)
+        for key in self.lanes.plan.order:  # one lane per event, also for one that never runs
+            self.rec.log(self._lane(self.lanes.path(key)), rr.StateChange.cleared())
         self._task = [f"{layout.TASK}/{s.name}" for s in task]
         rec.send_recording_name(title)
         titles = [(s.name, f"{s.label} ({s.unit})") for s in task]
@@ -319,23 +322,23 @@ class RerunSink:
         self.rec.set_time("sim_time", duration=np.timedelta64(round(t * 1e9), "ns"))
         self.rec.set_time("tick", sequence=tick)
 
+    def _lane(self, lane: tuple[str, ...]) -> str:
+        """The lane's entity path; the first time, its colours (static), which also make
+        the lane show in the panel before anything runs on it."""
+        path = rr.new_entity_path(list(lane))
+        if lane not in self._lanes_seen:
+            self._lanes_seen.add(lane)
+            colors = [(r << 24) | (g << 16) | (b << 8) | 0xFF for r, g, b in STATE_COLORS.values()]
+            config = rr.StateConfiguration(
+                values=list(STATE_COLORS), colors=np.array(colors, dtype=np.uint32)
+            )
+            self.rec.log(path, config, static=True)
+        return path
+
     def _phases(self, phases: list[Phase]) -> None:
         """Lane changes, each at its own time; a lane's first change brings its colours."""
         for phase in phases:
-            path = rr.new_entity_path(list(phase.lane))
-            if phase.lane not in self._lanes_seen:
-                self._lanes_seen.add(phase.lane)
-                config = rr.StateConfiguration(
-                    values=list(STATE_COLORS),
-                    colors=np.array(
-                        [
-                            (r << 24) | (g << 16) | (b << 8) | 0xFF
-                            for r, g, b in STATE_COLORS.values()
-                        ],
-                        dtype=np.uint32,
-                    ),
-                )
-                self.rec.log(path, config, static=True)
+            path = self._lane(phase.lane)
             self._at(phase.t, phase.tick)
             state = (
                 rr.StateChange.cleared()

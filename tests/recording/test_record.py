@@ -110,9 +110,13 @@ def test_record_holds_the_run_and_leaves_the_log_unchanged(
         assert len(buffers) == len(joints)
         assert all(np.frombuffer(bytes(b[0]), np.float32).shape == (256,) for b in buffers)
 
-    # Event lanes: running from a start, then the outcome over the same span, then held.
+    # Event lanes: every event's lane is there from time 0, empty (so that an event that
+    # never runs has its lane too); then running from a start, the outcome over the same
+    # span, then held.
+    for name in ("/01_to", "/02_open", "/03_grab", "/04_down", "/05_forces"):
+        assert _rows(chunks, name, "StateChange:state")[0] == [], name
     lane = _rows(chunks, "/02_open", "StateChange:state")
-    assert lane[:3] == [["running"], ["done"], ["held"]] and lane[-1] in ([], [""])  # ends it
+    assert lane[1:4] == [["running"], ["done"], ["held"]] and lane[-1] in ([], [""])  # ends it
     text = [t[0] for t in _rows(chunks, "/events/log", "TextLog:text")]
     assert "start to (line 9)" in text and any(t.startswith("end   grab done") for t in text)
     assert any(t.startswith(("OK", "FAILED")) for t in text)  # the criteria, at the end
