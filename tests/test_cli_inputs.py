@@ -23,6 +23,11 @@ RUN_CASES = [
     (["--tick", "1e9"], 2, "dial: --tick must be above 0 s and at most 60 s (as @tick), got 1e+09"),
     (["--tick", "0"], 2, "dial: --tick must be above 0 s and at most 60 s (as @tick), got 0"),
     (["--speed", "-1"], 2, "dial: --speed must be a positive number, got -1"),
+    (
+        ["--speed", "1e-300"],
+        2,
+        "dial: the tick must be above 0 s and at most 60 s, got 1e+299 s (--speed 1e-300)",
+    ),
     (["--seed", "-1", "--perturb", "5"], 2, "dial: --seed must be 0 or more, got -1"),
     (["--perturb", "-5"], 2, "dial: --perturb must be 0 mm or more, got -5"),
     (["--perturb", "nan"], 2, "dial: --perturb must be 0 mm or more, got nan"),

@@ -25,7 +25,7 @@ from dial.engine.observe import Observer, StateLog, Watched, describe, fan_out, 
 from dial.engine.result import RunResult, measure_criteria
 from dial.engine.setup import prepare
 from dial.engine.state import RunSettings, Saved
-from dial.errors import DialError
+from dial.errors import DialError, OptionError
 from dial.parser.lanes import LanePlan
 from dial.parser.script import Script
 from dial.primitives import Context, make_factory
@@ -65,10 +65,12 @@ def tick_length(script: Script, options: RunOptions) -> float:
     """The tick the run uses, in s: ``--tick``, else ``@tick``, else the default; / speed."""
     tick = options.tick if options.tick is not None else (script.tick or DEFAULT_TICK)
     if not (math.isfinite(options.speed) and options.speed > 0):
-        raise DialError(f"--speed must be a positive number, got {options.speed:g}")
+        raise OptionError(f"--speed must be a positive number, got {options.speed:g}")
     if not (math.isfinite(tick) and 0 < tick / options.speed <= MAX_TICK):
-        raise DialError(
-            f"the tick must be above 0 s and at most {MAX_TICK:g} s, got {tick / options.speed:g}"
+        by = f" (--speed {options.speed:g})" if options.speed != 1.0 else ""
+        raise OptionError(
+            f"the tick must be above 0 s and at most {MAX_TICK:g} s, got "
+            f"{tick / options.speed:g} s{by}"
         )
     return tick / options.speed
 
