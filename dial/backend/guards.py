@@ -38,20 +38,28 @@ class Readings:
     :func:`~dial.backend.contact.contact_reading`'s; a dropped-out sensor reads 0. One per
     robot: :meth:`at_step` starts each step afresh."""
 
-    __slots__ = ("_data", "_diff", "_dropped", "_index", "_q", "_tactile", "_target")
+    __slots__ = ("_data", "_dev", "_dropped", "_index", "_q", "_tactile", "_target", "_tensions")
 
     def __init__(self, data: mujoco.MjData, index: RobotIndex, tactile_adr: Sequence[int]) -> None:
         self._data, self._index = data, index
         # Views into sensordata stay valid for the data's life: slicing once saves a lot.
         self._tactile = [data.sensordata[a : a + 256] for a in tactile_adr]
+        adr = index.tension_sensors
+        first = int(adr[0])
+        # The 32 tensions as a view where they run in order (flexor, extensor per joint).
+        in_order = np.array_equal(adr, np.arange(first, first + len(adr)))
+        self._tensions = data.sensordata[first : first + len(adr)] if in_order else None
         self._target: FloatArray = np.zeros(16)
         self._dropped: frozenset[tuple[str, int]] = frozenset()
-        self._diff: FloatArray | None = None
+        # Per guard baseline (by id, for this step): each finger's largest |change| (N).
+        self._dev: dict[int, list[float]] = {}
         self._q: FloatArray | None = None
 
     def at_step(self, target: FloatArray, dropped: frozenset[tuple[str, int]]) -> Readings:
         self._target, self._dropped = target, dropped
-        self._diff = self._q = None
+        self._q = None
+        if self._dev:
+            self._dev = {}
         return self
 
     def value(self, kind: str, f: int, baseline: FloatArray) -> float:
@@ -60,13 +68,23 @@ class Readings:
             return 0.0
         if kind == "tactile":
             return float(self._tactile[f].max())
-        joints = slice(4 * f, 4 * f + 4)
         if kind == "force":
-            if self._diff is None:
-                self._diff = tendon_differentials(self._data, self._index)
-            return float(np.abs(self._diff[joints] - baseline[joints]).max())
+            # All four fingers at once, once per guard and step: a monitor on two fingers,
+            # or two monitors, cost one array expression instead of one per finger.
+            dev = self._dev.get(id(baseline))
+            if dev is None:
+                t = self._tensions
+                diff = (
+                    t[0::2] - t[1::2]
+                    if t is not None
+                    else tendon_differentials(self._data, self._index)
+                )
+                dev = np.abs(diff - baseline).reshape(4, 4).max(axis=1).tolist()
+                self._dev[id(baseline)] = dev
+            return dev[f]
         if self._q is None:
             self._q = self._data.qpos[self._index.hand_qpos]
+        joints = slice(4 * f, 4 * f + 4)
         return float(np.linalg.norm(self._target[joints] - self._q[joints])) * POSITION_LEVER
 
 
