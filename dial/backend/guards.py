@@ -38,7 +38,9 @@ class Readings:
     :func:`~dial.backend.contact.contact_reading`'s; a dropped-out sensor reads 0. One per
     robot: :meth:`at_step` starts each step afresh."""
 
-    __slots__ = ("_data", "_dev", "_dropped", "_index", "_q", "_tactile", "_target", "_tensions")
+    __slots__ = (
+        "_data", "_dev", "_diff", "_dropped", "_index", "_q", "_tactile", "_target", "_tensions"
+    )  # fmt: skip
 
     def __init__(self, data: mujoco.MjData, index: RobotIndex, tactile_adr: Sequence[int]) -> None:
         self._data, self._index = data, index
@@ -53,11 +55,12 @@ class Readings:
         self._dropped: frozenset[tuple[str, int]] = frozenset()
         # Per guard baseline (by id, for this step): each finger's largest |change| (N).
         self._dev: dict[int, list[float]] = {}
+        self._diff: FloatArray | None = None
         self._q: FloatArray | None = None
 
     def at_step(self, target: FloatArray, dropped: frozenset[tuple[str, int]]) -> Readings:
         self._target, self._dropped = target, dropped
-        self._q = None
+        self._diff = self._q = None
         if self._dev:
             self._dev = {}
         return self
@@ -73,13 +76,14 @@ class Readings:
             # or two monitors, cost one array expression instead of one per finger.
             dev = self._dev.get(id(baseline))
             if dev is None:
-                t = self._tensions
-                diff = (
-                    t[0::2] - t[1::2]
-                    if t is not None
-                    else tendon_differentials(self._data, self._index)
-                )
-                dev = np.abs(diff - baseline).reshape(4, 4).max(axis=1).tolist()
+                if self._diff is None:  # once per step, whatever the number of guards
+                    t = self._tensions
+                    self._diff = (
+                        t[0::2] - t[1::2]
+                        if t is not None
+                        else tendon_differentials(self._data, self._index)
+                    )
+                dev = np.abs(self._diff - baseline).reshape(4, 4).max(axis=1).tolist()
                 self._dev[id(baseline)] = dev
             return dev[f]
         if self._q is None:
