@@ -39,13 +39,20 @@ class Readings:
     robot: :meth:`at_step` starts each step afresh."""
 
     __slots__ = (
-        "_data", "_dev", "_diff", "_dropped", "_index", "_q", "_tactile", "_target", "_tensions"
+        "_all", "_data", "_dev", "_diff", "_dropped", "_index", "_q", "_tactile", "_target",
+        "_tensions", "_tips",
     )  # fmt: skip
 
     def __init__(self, data: mujoco.MjData, index: RobotIndex, tactile_adr: Sequence[int]) -> None:
         self._data, self._index = data, index
         # Views into sensordata stay valid for the data's life: slicing once saves a lot.
         self._tactile = [data.sensordata[a : a + 256] for a in tactile_adr]
+        # The four arrays as one (4, 256) view where they follow each other (they do in
+        # dial's models): a guard sensing every finger then reads four maxima in one call.
+        first = int(tactile_adr[0])
+        together = list(tactile_adr) == [first + 256 * f for f in range(len(tactile_adr))]
+        self._all = data.sensordata[first : first + 1024].reshape(4, 256) if together else None
+        self._tips: list[float] | None = None
         adr = index.tension_sensors
         first = int(adr[0])
         # The 32 tensions as a view where they run in order (flexor, extensor per joint).
@@ -60,7 +67,7 @@ class Readings:
 
     def at_step(self, target: FloatArray, dropped: frozenset[tuple[str, int]]) -> Readings:
         self._target, self._dropped = target, dropped
-        self._diff = self._q = None
+        self._diff = self._q = self._tips = None
         if self._dev:
             self._dev = {}
         return self
@@ -70,7 +77,11 @@ class Readings:
         if self._dropped and (kind, f) in self._dropped:
             return 0.0
         if kind == "tactile":
-            return float(self._tactile[f].max())
+            if self._all is None:
+                return float(self._tactile[f].max())
+            if self._tips is None:  # once per step, whatever the guards and fingers
+                self._tips = self._all.max(axis=1).tolist()
+            return self._tips[f]
         if kind == "force":
             # All four fingers at once, once per guard and step: a monitor on two fingers,
             # or two monitors, cost one array expression instead of one per finger.

@@ -12,15 +12,16 @@ from __future__ import annotations
 
 import math
 from abc import abstractmethod
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
 from dial.backend.snapshot import FloatArray, Snapshot
-from dial.geometry import rpy_matrix, slerp, smooth
+from dial.geometry import rpy_matrix, slerp, smooth, smooth_array
 from dial.primitives.context import Context, RobotPrimitive
 from dial.scene.valii import Appro, Depart, Drive, Move, Statement
-from dial.scheduler.types import DONE, Ended, Now, Outcome, RunInfo
+from dial.scheduler.types import DONE, Course, Ended, Now, Outcome, RunInfo
 
 JOINT_SPEED = 1.0  # rad/s: nominal, only to share a run's time among its segments
 LINEAR_SPEED = 0.25  # m/s
@@ -58,6 +59,16 @@ class Segment:
         k = int(x)
         a, b = self.waypoints[k], self.waypoints[k + 1]
         out: FloatArray = a + (b - a) * (x - k)
+        return out
+
+    def at_array(self, u: FloatArray) -> FloatArray:
+        """(K, 6): :meth:`at` of each fraction, bit for bit."""
+        last = len(self.waypoints) - 1
+        x = np.minimum(1.0, np.maximum(0.0, u)) * last
+        k = np.minimum(x.astype(np.intp), last - 1)
+        a, b = self.waypoints[k], self.waypoints[k + 1]
+        out: FloatArray = a + (b - a) * (x - k)[:, None]
+        out[x >= last] = self.q1
         return out
 
 
@@ -148,6 +159,8 @@ class ArmMotion(RobotPrimitive):
         for s in self.segments:
             acc += s.cost / total if total > 0 else 1.0 / len(self.segments)
             self.bounds.append(acc)
+        self._ends = np.array(self.bounds)  # for course: each segment's end and start
+        self._starts = np.concatenate(([0.0], self._ends[:-1]))
         self.q = snapshot.arm_target.copy()
 
     def step(self, snapshot: Snapshot, now: Now) -> Ended | None:
@@ -162,8 +175,35 @@ class ArmMotion(RobotPrimitive):
         self.slots.arm(self.q)
         return None
 
+    open_loop = True
+
+    def course(self, progress: Sequence[float]) -> Course:
+        """The set-points :meth:`step` would write at each progress, computed as one array."""
+        if not self.segments:
+            return _unmoved
+        p = np.asarray(progress, dtype=np.float64)
+        if len(self.segments) == 1:
+            u = smooth_array(p / max(self.bounds[0], 1e-12))
+            return self.slots.arm_course(self.segments[0].at_array(u))
+        ends = self._ends
+        # The first segment whose end (+1e-12) the progress has not passed, as step's loop.
+        which = np.minimum(np.searchsorted(ends + 1e-12, p, side="left"), len(ends) - 1)
+        starts = self._starts[which]
+        u = smooth_array((p - starts) / np.maximum(ends[which] - starts, 1e-12))
+        first, last = int(which[0]), int(which[-1])  # progress only grows: a run of segments
+        if first == last:
+            return self.slots.arm_course(self.segments[first].at_array(u))
+        rows = np.empty((len(p), 6))
+        for j in range(first, last + 1):
+            rows[which == j] = self.segments[j].at_array(u[which == j])
+        return self.slots.arm_course(rows)
+
     def finish(self, snapshot: Snapshot) -> Ended:
         return Ended(Outcome.DONE, warnings=self.warnings) if self.warnings else DONE
+
+
+def _unmoved(k: int) -> None:
+    """The course of a run with nothing to move: it writes nothing."""
 
 
 class PumaCommand(ArmMotion):

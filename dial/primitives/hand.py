@@ -2,16 +2,22 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 
 from dial.backend.snapshot import FloatArray, Snapshot
-from dial.geometry import smooth
+from dial.geometry import smooth, smooth_array
 from dial.primitives.context import Context, RobotPrimitive, done, missed
-from dial.scheduler.types import Ended, Now, RunInfo
+from dial.scheduler.types import Course, Ended, Now, RunInfo
 
 
 def _bits(mask: int) -> list[int]:
     return [k for k in range(16) if mask >> k & 1]
+
+
+def _nothing(k: int) -> None:
+    """The course of a run that writes no set-points."""
 
 
 class HandPose(RobotPrimitive):
@@ -29,6 +35,12 @@ class HandPose(RobotPrimitive):
     def step(self, snapshot: Snapshot, now: Now) -> Ended | None:
         self.slots.joints(self.mask, self.q0 + (self.q1 - self.q0) * smooth(now.progress))
         return None
+
+    open_loop = True
+
+    def course(self, progress: Sequence[float]) -> Course:
+        s = smooth_array(np.asarray(progress, dtype=np.float64))
+        return self.slots.joints_course(self.mask, self.q0 + (self.q1 - self.q0) * s[:, None])
 
 
 class GraspForce(RobotPrimitive):
@@ -90,6 +102,11 @@ class Limp(RobotPrimitive):
 
     def step(self, snapshot: Snapshot, now: Now) -> Ended | None:
         return None
+
+    open_loop = True  # the limp joints follow their measured angle in the driver
+
+    def course(self, progress: Sequence[float]) -> Course:
+        return _nothing
 
     def finish(self, snapshot: Snapshot) -> Ended:
         self.slots.limp(self.mask, False)
