@@ -68,24 +68,28 @@ class GraspForce(RobotPrimitive):
             for f in self.fingers
         }
         self.stopped: dict[int, float] = {}
+        self.jbits, self.tbits = _bits(self.jmask), _bits(self.tmask)
+        self.monitored = {k // 4 for k in self.tbits} or set(self.fingers)
 
     def step(self, snapshot: Snapshot, now: Now) -> Ended | None:
-        diff = snapshot.differentials
+        diff = snapshot.differentials.tolist()
         for f in self.fingers:
             if f not in self.stopped and max(diff[k] for k in self.watched[f]) >= self.force:
                 self.stopped[f] = now.sim_time
-        closing = [k for k in _bits(self.jmask) if k // 4 not in self.stopped]
+        closing = [k for k in self.jbits if k // 4 not in self.stopped]
         self.target[closing] = np.minimum(self.target[closing] + self.rate, self.upper[closing])
         self.slots.joints(self.jmask, self.target)
-        monitored = {k // 4 for k in _bits(self.tmask)} or set(self.fingers)
-        forces = {f"j{k}": float(diff[k]) for k in _bits(self.tmask)}
-        if monitored <= set(self.stopped):
-            return done(forces=forces)
-        if all(self.target[k] >= self.upper[k] for k in closing) and not monitored & set(
-            self.stopped
+        if self.monitored <= self.stopped.keys():
+            return done(forces=self._forces(diff))
+        if all(self.target[k] >= self.upper[k] for k in closing) and not (
+            self.monitored & self.stopped.keys()
         ):
-            return missed("the fingers closed fully without reaching the force", forces=forces)
+            message = "the fingers closed fully without reaching the force"
+            return missed(message, forces=self._forces(diff))
         return None
+
+    def _forces(self, diff: list[float]) -> dict[str, float]:
+        return {f"j{k}": diff[k] for k in self.tbits}
 
 
 class Limp(RobotPrimitive):
