@@ -9,6 +9,7 @@ any free body inside it (the pitcher's balls), until the hand opens the gripping
 
 from __future__ import annotations
 
+import copy
 from collections.abc import Collection
 from dataclasses import dataclass
 
@@ -16,7 +17,7 @@ import mujoco
 import numpy as np
 
 from dial.backend.driver import MujocoRobot
-from dial.backend.ik import ArmIK
+from dial.backend.ik import FingerIK, LeanArmIK
 from dial.backend.model import ARM_HOME, load_model
 from dial.backend.snapshot import FloatArray
 from dial.engine.setup import scene_bodies
@@ -94,11 +95,11 @@ class Scene:
         }
         self.robot = robot = MujocoRobot(model, data)
         self.index = robot.index
-        ik = ArmIK()
+        ik = LeanArmIK()  # the run's IK to rounding, faster; the fingers' on the same model
         pos, rot = home_pose(world, believed)
         home = ik.solve(pos, rot, np.array(ARM_HOME), "the start pose (location 'home')")
         robot.arm_target = home
-        self.ctx = Context(robot, world, believed, ik)
+        self.ctx = Context(robot, world, believed, ik, FingerIK(copy.copy(ik.model)))
         self.parts = parts = Parts.of(model, robot.index)
         names = [model.body(b).name for b in range(model.nbody)]
         group = np.where(parts.arm, ARM, np.where(parts.robot, PALM, -1))

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from dial.backend.snapshot import FloatArray, Snapshot
-from dial.geometry import rpy_matrix, slerp, smooth
+from dial.geometry import Slerp, rpy_matrix, smooth
 from dial.primitives.context import Context, RobotPrimitive
 from dial.scene.valii import Appro, Depart, Drive, Move, Statement
 from dial.scheduler.types import DONE, Ended, Now, Outcome, RunInfo
@@ -81,10 +81,10 @@ class Planner:
         length = float(np.linalg.norm(p1 - p0))
         turn = float(np.arccos(np.clip((np.trace(r0.T @ r1) - 1.0) / 2.0, -1.0, 1.0)))
         n = max(1, math.ceil(max(length / LINE_STEP, turn / LINE_TURN_STEP)))
-        waypoints = [self.q]
+        waypoints, turning = [self.q], Slerp(r0, r1)
         for k in range(1, n):
             u = k / n
-            waypoints.append(ik.track(p0 + (p1 - p0) * u, slerp(r0, r1, u), waypoints[-1]))
+            waypoints.append(ik.track(p0 + (p1 - p0) * u, turning(u), waypoints[-1]))
         waypoints.append(q1)
         cost = max(length / LINEAR_SPEED, turn / TURN_SPEED)
         self.segments.append(Segment(np.stack(waypoints), cost))
