@@ -18,7 +18,7 @@ import numpy as np
 
 from dial.backend.driver import MujocoRobot
 from dial.backend.ik import FingerIK, LeanArmIK
-from dial.backend.model import ARM_HOME, load_model
+from dial.backend.model import ARM_HOME, load_model, load_untextured
 from dial.backend.snapshot import FloatArray
 from dial.engine.setup import scene_bodies
 from dial.instructions.types import FINGERS
@@ -64,7 +64,8 @@ class Held:
     """Bodies carried with the palm: their poses in the tool frame, and the grip holding them."""
 
     bodies: tuple[int, ...]
-    adr: np.ndarray  # (N, 7) qpos addresses of each body's free joint
+    pos_adr: np.ndarray  # (3N,) qpos addresses of the bodies' free-joint positions
+    quat_adr: np.ndarray  # (4N,) and orientations
     pos: FloatArray  # (N, 3) positions in the tool frame
     quat: FloatArray  # (N, 4) orientations in the tool frame
     fingers: frozenset[int]
@@ -82,11 +83,15 @@ class State:
 
 
 class Scene:
-    """One scene's model and data, posed kinematically; the robot starts at ``home``."""
+    """One scene's model and data, posed kinematically; the robot starts at ``home``.
 
-    def __init__(self, world: World) -> None:
+    Without ``textures`` (only drawing needs them) the scene compiles several times faster.
+    """
+
+    def __init__(self, world: World, textures: bool = True) -> None:
         self.world = world
-        self.model = model = load_model(world.model_path)
+        load = load_model if textures else load_untextured
+        self.model = model = load(world.model_path)
         self.data = data = mujoco.MjData(model)
         mujoco.mj_forward(model, data)
         believed = {
@@ -110,15 +115,20 @@ class Scene:
         _robot_contacts_only(model, parts.robot)
         self.root = model.body_rootid[model.geom_bodyid]  # each geom's top body
         self.held: tuple[Held, ...] = ()
+        self._released: tuple[bytes, tuple[Held, ...]] = (b"", ())  # hand and grips last let go
+        arm_lo, arm_hi = robot.arm_range.T.copy()
+        hand_lo, hand_hi = robot.hand_range.T.copy()
+        self._limits = (arm_lo, arm_hi, hand_lo, hand_hi)
         self.pose()
 
     # -- posing ------------------------------------------------------------------------------------
     def pose(self) -> None:
         """Put the robot at its set-points (carrying what it holds) and find the contacts."""
         m, d, ix, r = self.model, self.data, self.index, self.robot
+        arm_lo, arm_hi, hand_lo, hand_hi = self._limits
         # The servos stop at the joint limits (a target beyond one is reported by the checks).
-        d.qpos[ix.arm_qpos] = np.clip(r.arm_target, r.arm_range[:, 0], r.arm_range[:, 1])
-        d.qpos[ix.hand_qpos] = np.clip(r.hand_target, r.hand_range[:, 0], r.hand_range[:, 1])
+        d.qpos[ix.arm_qpos] = np.minimum(np.maximum(r.arm_target, arm_lo), arm_hi)
+        d.qpos[ix.hand_qpos] = np.minimum(np.maximum(r.hand_target, hand_lo), hand_hi)
         mujoco.mj_kinematics(m, d)
         if self.held:
             self._let_go()
@@ -237,12 +247,13 @@ class Scene:
         carried = sorted(set(bodies) | self._contents(bodies))
         pos, rot = self.tool()
         adr = m.jnt_qposadr[m.body_jntadr[carried]][:, None] + np.arange(7)
+        pos_adr, quat_adr = adr[:, :3].ravel(), adr[:, 3:].ravel()
         quat = np.empty((len(carried), 4))
         for i, b in enumerate(carried):
             mujoco.mju_mat2Quat(quat[i], (rot.T @ d.xmat[b].reshape(3, 3)).reshape(-1))
         offsets = (d.xpos[carried] - pos) @ rot
         hand = self.robot.hand_target.copy()
-        grip = Held(tuple(carried), adr, offsets, quat, frozenset(fingers), hand)
+        grip = Held(tuple(carried), pos_adr, quat_adr, offsets, quat, frozenset(fingers), hand)
         self.held = (*self.held, grip)
 
     def _contents(self, bodies: Collection[int]) -> set[int]:
@@ -270,20 +281,27 @@ class Scene:
     def _let_go(self) -> None:
         """Drop the grips whose fingers opened."""
         flex = self.robot.hand_target
+        hand, grips = self._released
+        if grips is self.held and hand == flex.tobytes():  # as the last time
+            return
         kept = []
         for grip in self.held:
             joints = [4 * f + j for f in grip.fingers for j in (1, 2, 3)]
             if not np.any(flex[joints] < grip.closed[joints] - RELEASE):
                 kept.append(grip)
         self.held = tuple(kept)
+        self._released = (flex.tobytes(), self.held)
 
     def _carry(self) -> None:
-        pos, rot = self.tool()
+        d, site = self.data, self.index.tool_site
+        pos, rot = d.site_xpos[site], d.site_xmat[site].reshape(3, 3)
         tool = np.empty(4)
-        mujoco.mju_mat2Quat(tool, rot.reshape(-1))
-        for grip in self.held:
-            self.data.qpos[grip.adr[:, :3]] = pos + grip.pos @ rot.T
-            self.data.qpos[grip.adr[:, 3:]] = _quat_products(tool, grip.quat)
+        mujoco.mju_mat2Quat(tool, d.site_xmat[site])
+        w, x, y, z = tool
+        product = np.array([[w, -x, -y, -z], [x, w, -z, y], [y, z, w, -x], [z, -y, x, w]])
+        for grip in self.held:  # positions and orientations in the tool frame, in the world
+            d.qpos[grip.pos_adr] = (pos + grip.pos @ rot.T).ravel()
+            d.qpos[grip.quat_adr] = (grip.quat @ product.T).ravel()
 
     # -- branches ----------------------------------------------------------------------------------
     def save(self) -> State:
@@ -305,21 +323,6 @@ def _robot_contacts_only(model: mujoco.MjModel, robot: np.ndarray) -> None:
     model.geom_contype[colliding & robot] |= 2
     model.geom_contype[colliding & ~robot] = 0
     model.geom_conaffinity[colliding & ~robot] = 2
-
-
-def _quat_products(a: FloatArray, b: FloatArray) -> FloatArray:
-    """The quaternion products a * b[i] (w, x, y, z), for one ``a`` (4,) and ``b`` (N, 4)."""
-    w, x, y, z = a
-    bw, bx, by, bz = b.T
-    return np.stack(
-        [
-            w * bw - x * bx - y * by - z * bz,
-            w * bx + x * bw + y * bz - z * by,
-            w * by - x * bz + y * bw + z * bx,
-            w * bz + x * by - y * bx + z * bw,
-        ],
-        axis=1,
-    )
 
 
 def _box(m: mujoco.MjModel, d: mujoco.MjData, geom: int) -> tuple[FloatArray, FloatArray]:
