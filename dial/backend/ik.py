@@ -7,6 +7,7 @@ one: a straight-line move solves one waypoint per control period.
 
 from __future__ import annotations
 
+import math
 from collections import OrderedDict
 
 import mink
@@ -191,20 +192,29 @@ class LeanArmIK(ArmIK):
 
     def __init__(self, model: mujoco.MjModel | None = None) -> None:
         super().__init__(model)
-        limit, qpos = self.limits[0], self.index.arm_qpos
-        self._dof = self.index.arm_dof
+        limit, task, qpos = self.limits[0], self.task, self.index.arm_qpos
+        self._qpos, self._dof = qpos, self.index.arm_dof
         self._reach = (limit.gain * limit.lower[qpos], limit.gain * limit.upper[qpos], limit.gain)
+        self._weights = (task.cost * -task.gain, task.cost[:, None])
         self._velocity = np.zeros(self.model.nv)
 
+    def _set(self, arm_q: FloatArray) -> None:
+        data = self.config.data
+        if data.qpos[self._qpos].tobytes() != np.asarray(arm_q, dtype=np.float64).tobytes():
+            data.qpos[self._qpos] = arm_q
+            self.config.update()
+
     def _iterate(self, pos: FloatArray, rot: FloatArray, iterations: int) -> tuple[float, float]:
-        start = self.config.q.copy()
-        target = mink.SE3.from_rotation_and_translation(mink.SO3.from_matrix(rot), pos)
-        self.task.set_target(target)
         task, config = self.task, self.config
+        target = np.empty(7)
+        mujoco.mju_mat2Quat(target[:4], np.ascontiguousarray(rot, dtype=np.float64).ravel())
+        target[4:] = pos
+        task.set_target(mink.SE3(wxyz_xyz=target))
         solving = iterations >= SOLVE_ITERATIONS
+        start = config.data.qpos.copy()
         for _ in range(iterations):
             err = task.compute_error(config)
-            perr, rerr = float(np.linalg.norm(err[:3])), float(np.linalg.norm(err[3:]))
+            perr, rerr = math.sqrt(err[:3] @ err[:3]), math.sqrt(err[3:] @ err[3:])
             if perr < POS_TOL and rerr < ROT_TOL:
                 return perr, rerr
             step = self._step(err, task.compute_jacobian(config)[:, self._dof])
@@ -232,16 +242,14 @@ class LeanArmIK(ArmIK):
     def _step(self, err: FloatArray, jac: FloatArray) -> FloatArray | None:
         """The QP's unconstrained minimum (mink's weights, gain and damping); None if it
         would take a joint past ``gain`` of its way to a limit."""
-        task = self.task
-        error = task.cost * (-task.gain * err)
-        weighted = task.cost[:, None] * jac
-        damping = DAMPING + task.lm_damping * float(error @ error)
+        error_weights, jac_weights = self._weights
+        error, weighted = error_weights * err, jac_weights * jac
         hessian = weighted.T @ weighted
-        hessian.flat[:: len(hessian) + 1] += damping
+        hessian.flat[:: len(hessian) + 1] += DAMPING + self.task.lm_damping * float(error @ error)
         step = np.asarray(np.linalg.solve(hessian, error @ weighted), dtype=np.float64)
         low, high, gain = self._reach
-        q = self.config.q[self.index.arm_qpos]
-        if (step < low - gain * q).any() or (step > high - gain * q).any():
+        moved = gain * self.config.data.qpos[self._qpos]
+        if ((step < low - moved) | (step > high - moved)).any():
             return None
         return step
 

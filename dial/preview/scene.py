@@ -141,6 +141,10 @@ class Scene:
         site = self.index.tool_site
         return self.data.site_xpos[site].copy(), self.data.site_xmat[site].reshape(3, 3).copy()
 
+    def tool_position(self) -> FloatArray:
+        position: FloatArray = self.data.site_xpos[self.index.tool_site].copy()
+        return position
+
     def tip(self, finger: int) -> FloatArray:
         tip: FloatArray = self.data.site_xpos[self.index.fingertip_sites[finger]].copy()
         return tip

@@ -309,9 +309,10 @@ class Walk:
     def glance(self) -> None:
         """Look at the pose if it moved enough since it was last looked at."""
         arm, hand = self.scene.robot.arm_target, self.scene.robot.hand_target
-        if (
-            np.abs(arm - self.seen[0]).max() > ARM_STEP
-            or np.abs(hand - self.seen[1]).max() > HAND_STEP
+        seen_arm, seen_hand = self.seen
+        if np.abs(arm - seen_arm).max() > ARM_STEP or (
+            hand.tobytes() != seen_hand.tobytes()  # the hand seldom moves: compare it fast
+            and np.abs(hand - seen_hand).max() > HAND_STEP
         ):
             self.look()
 
@@ -323,7 +324,7 @@ class Walk:
         """Record the posed scene's problems, each on the run that caused it."""
         robot = self.scene.robot
         self.seen = (robot.arm_target.copy(), robot.hand_target.copy())
-        self.trace.append(self.scene.tool()[0])
+        self.trace.append(self.scene.tool_position())
         ongoing: dict[tuple[str, str, str], tuple[Place, str]] = {}
         for hit in self.scene.hits():
             # A contact that goes on from the last look stays with the run that made it.
