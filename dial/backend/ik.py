@@ -197,6 +197,8 @@ class LeanArmIK(ArmIK):
         self._reach = (limit.gain * limit.lower[qpos], limit.gain * limit.upper[qpos], limit.gain)
         self._weights = (task.cost * -task.gain, task.cost[:, None])
         self._velocity = np.zeros(self.model.nv)
+        self._eye = np.eye(len(qpos))
+        self._eye_damping = DAMPING * self._eye
 
     def _set(self, arm_q: FloatArray) -> None:
         data = self.config.data
@@ -245,13 +247,18 @@ class LeanArmIK(ArmIK):
         error_weights, jac_weights = self._weights
         error, weighted = error_weights * err, jac_weights * jac
         hessian = weighted.T @ weighted
-        hessian.flat[:: len(hessian) + 1] += DAMPING + self.task.lm_damping * float(error @ error)
+        hessian += self._damping(error)
         step = np.asarray(np.linalg.solve(hessian, error @ weighted), dtype=np.float64)
         low, high, gain = self._reach
         moved = gain * self.config.data.qpos[self._qpos]
         if ((step < low - moved) | (step > high - moved)).any():
             return None
         return step
+
+    def _damping(self, error: FloatArray) -> FloatArray:
+        """mink's damping of the step, on the hessian's diagonal."""
+        lm = self.task.lm_damping
+        return self._eye * (DAMPING + lm * float(error @ error)) if lm else self._eye_damping
 
 
 # Start offsets for ArmIK.solve: as given, then wrist (joints 4 and 6) and elbow variations.

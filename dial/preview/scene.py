@@ -116,6 +116,7 @@ class Scene:
         self.root = model.body_rootid[model.geom_bodyid]  # each geom's top body
         self.held: tuple[Held, ...] = ()
         self._released: tuple[bytes, tuple[Held, ...]] = (b"", ())  # hand and grips last let go
+        self._carried: tuple[tuple[Held, ...], np.ndarray] = ((), np.zeros(model.ngeom, bool))
         arm_lo, arm_hi = robot.arm_range.T.copy()
         hand_lo, hand_hi = robot.hand_range.T.copy()
         self._limits = (arm_lo, arm_hi, hand_lo, hand_hi)
@@ -150,30 +151,40 @@ class Scene:
         return tip
 
     # -- contacts ----------------------------------------------------------------------------------
-    def _contacts(self) -> list[tuple[int, int, float]]:
-        """(robot geom, other geom, depth m) of every penetrating contact of the robot."""
+    def _contacts(self, held: bool = True) -> list[tuple[int, int, float]]:
+        """(robot geom, other geom, depth m) of every penetrating contact of the robot;
+        without ``held``, not those with what the hand holds."""
         n = self.data.ncon
         if n == 0:
             return []
-        c = self.data.contact
+        c, group = self.data.contact, self.group
         g1, g2, dist = c.geom1[:n], c.geom2[:n], c.dist[:n]
-        keep = ((self.group[g1] >= 0) | (self.group[g2] >= 0)) & (dist < 0)
+        keep = ((group[g1] >= 0) | (group[g2] >= 0)) & (dist < 0)
+        if not held and self.held:
+            carried = self._held_geoms()
+            keep &= ~(carried[g1] | carried[g2])
         out = []
-        for a, b, d in zip(g1[keep], g2[keep], dist[keep], strict=True):
-            ga, gb = self.group[a], self.group[b]
+        for a, b, d in zip(g1[keep].tolist(), g2[keep].tolist(), dist[keep].tolist(), strict=True):
+            ga, gb = group[a], group[b]
             first = ga >= 0 and (gb < 0 or ga <= gb)  # the robot's geom first, the arm's first
-            out.append((int(a), int(b), -float(d)) if first else (int(b), int(a), -float(d)))
+            out.append((a, b, -d) if first else (b, a, -d))
         return out
+
+    def _held_geoms(self) -> np.ndarray:
+        """Whether each geom belongs to what the hand holds."""
+        grips, mask = self._carried
+        if grips is not self.held:
+            mask = np.isin(self.root, list(self.held_bodies()))
+            self._carried = (self.held, mask)
+        return mask
 
     def touches(self, groups: Collection[int], held: bool = True) -> set[int]:
         """The geoms that geoms of ``groups`` touch now (other robot parts included); without
         ``held``, not those of what the hand holds."""
-        skip = set() if held else self.held_bodies()
         out: set[int] = set()
-        for a, b, _ in self._contacts():
+        for a, b, _ in self._contacts(held):
             for mine, other in ((a, b), (b, a)):
-                mine_in = self.group[mine] in groups
-                if mine_in and self.group[other] not in groups and self.root[other] not in skip:
+                if self.group[mine] in groups and self.group[other] not in groups:
                     out.add(other)
         return out
 
@@ -184,14 +195,13 @@ class Scene:
 
     def hits(self) -> list[Hit]:
         """The contacts that are problems (see docs/debugging.md), one per pair of parts."""
-        held = self.held_bodies()
         out = []
-        for a, b, depth in self._contacts():
+        for a, b, depth in self._contacts(held=False):
             ga, gb = int(self.group[a]), int(self.group[b])
-            pair = f"{self._name(a)} and {self._name(b)}"
             if gb >= 0:  # the robot against itself (parent and child never collide)
                 if ga == gb or depth <= SELF_DEPTH:
                     continue
+                pair = f"{self._name(a)} and {self._name(b)}"
                 if ga == ARM:
                     text = f"the hand hits the arm ({pair})"
                 elif ga == PALM:
@@ -200,9 +210,7 @@ class Scene:
                     text = f"the {_PART[ga]} and the {_PART[gb]} collide ({pair})"
                 out.append(Hit(_effectors(ga, gb), ("self", _PART[ga], _PART[gb]), text, depth))
                 continue
-            if self.root[b] in held:
-                continue
-            other = self._other(b)
+            other, pair = self._other(b), f"{self._name(a)} and {self._name(b)}"
             if ga == ARM:
                 kind, text = "arm", f"the arm hits {other} ({pair})"
             elif self.parts.fixed[b] and depth > FIXED_DEPTH:
