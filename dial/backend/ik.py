@@ -176,16 +176,16 @@ class ArmIK(_Base):
 
 
 class LeanArmIK(ArmIK):
-    """:class:`ArmIK` with mink's step solved directly, for ``dial preview``.
+    """:class:`ArmIK` whose tracking steps skip mink's QP machinery, for ``dial preview``.
 
     mink builds and solves a QP for each step of :meth:`ArmIK._iterate`: the frame task's
     damped least squares, the hand frozen, the arm inside its joint limits. While no limit
-    binds, the QP's answer is the least-squares step itself, one 6 x 6 linear solve, which is
-    taken from mink's own task error and Jacobian; a step that would pass a limit is left to
-    mink's QP. A start of :meth:`ArmIK.solve` that meets a limit or does not converge is done
-    again by mink from the start, so that it ends, or fails, exactly as the run's. So the
-    answers equal ArmIK's to rounding, for a fraction of the cost; they are memoized apart
-    from ArmIK's, so that a run never reads them.
+    binds, the QP's answer is the least-squares step itself: here one 6 x 6 linear solve over
+    the arm's joints, from mink's own task error and Jacobian. A step against a limit is
+    mink's. :meth:`ArmIK.track` (a line's waypoints, a guarded move's steps) so costs a
+    fifth, and its answers equal ArmIK's to rounding (1e-10 rad on the bundled scripts);
+    :meth:`ArmIK.solve` is mink's own, so that a target, and a target out of reach, come out
+    exactly as the run's. Memoized apart from ArmIK, so that a run never reads a track here.
     """
 
     MEMO = "lean-arm"
@@ -198,7 +198,6 @@ class LeanArmIK(ArmIK):
         self._weights = (task.cost * -task.gain, task.cost[:, None])
         self._velocity = np.zeros(self.model.nv)
         self._eye = np.eye(len(qpos))
-        self._eye_damping = DAMPING * self._eye
 
     def _set(self, arm_q: FloatArray) -> None:
         data = self.config.data
@@ -207,21 +206,20 @@ class LeanArmIK(ArmIK):
             self.config.update()
 
     def _iterate(self, pos: FloatArray, rot: FloatArray, iterations: int) -> tuple[float, float]:
+        if iterations >= SOLVE_ITERATIONS:  # a solve: mink's
+            return super()._iterate(pos, rot, iterations)
         task, config = self.task, self.config
         target = np.empty(7)
         mujoco.mju_mat2Quat(target[:4], np.ascontiguousarray(rot, dtype=np.float64).ravel())
         target[4:] = pos
         task.set_target(mink.SE3(wxyz_xyz=target))
-        solving = iterations >= SOLVE_ITERATIONS
-        start = config.data.qpos.copy()
+        perr = rerr = np.inf
         for _ in range(iterations):
             err = task.compute_error(config)
-            perr, rerr = math.sqrt(err[:3] @ err[:3]), math.sqrt(err[3:] @ err[3:])
+            perr, rerr = math.sqrt(err[:3].dot(err[:3])), math.sqrt(err[3:].dot(err[3:]))
             if perr < POS_TOL and rerr < ROT_TOL:
-                return perr, rerr
-            step = self._step(err, task.compute_jacobian(config)[:, self._dof])
-            if step is None and solving:  # against a limit: mink's, from the start
                 break
+            step = self._step(err, task.compute_jacobian(config)[:, self._dof])
             if step is None:  # against a limit: mink's step
                 velocity = mink.solve_ik(
                     config,
@@ -236,29 +234,21 @@ class LeanArmIK(ArmIK):
                 velocity = self._velocity
                 velocity[self._dof] = step / DT
             config.integrate_inplace(velocity, DT)
-        if not solving:
-            return perr, rerr
-        config.update(start)
-        return super()._iterate(pos, rot, iterations)
+        return perr, rerr
 
     def _step(self, err: FloatArray, jac: FloatArray) -> FloatArray | None:
         """The QP's unconstrained minimum (mink's weights, gain and damping); None if it
-        would take a joint past ``gain`` of its way to a limit."""
+        would take a joint past ``gain`` of its way to a limit (the QP's bound)."""
         error_weights, jac_weights = self._weights
         error, weighted = error_weights * err, jac_weights * jac
         hessian = weighted.T @ weighted
-        hessian += self._damping(error)
+        hessian += self._eye * (DAMPING + self.task.lm_damping * float(error @ error))
         step = np.asarray(np.linalg.solve(hessian, error @ weighted), dtype=np.float64)
         low, high, gain = self._reach
         moved = gain * self.config.data.qpos[self._qpos]
         if ((step < low - moved) | (step > high - moved)).any():
             return None
         return step
-
-    def _damping(self, error: FloatArray) -> FloatArray:
-        """mink's damping of the step, on the hessian's diagonal."""
-        lm = self.task.lm_damping
-        return self._eye * (DAMPING + lm * float(error @ error)) if lm else self._eye_damping
 
 
 # Start offsets for ArmIK.solve: as given, then wrist (joints 4 and 6) and elbow variations.
