@@ -13,6 +13,7 @@ from collections import OrderedDict
 import mink
 import mujoco
 import numpy as np
+from scipy.linalg import lapack
 
 from dial.backend.model import RobotIndex, load_model
 from dial.backend.snapshot import FloatArray
@@ -193,11 +194,12 @@ class LeanArmIK(ArmIK):
     def __init__(self, model: mujoco.MjModel | None = None) -> None:
         super().__init__(model)
         limit, task, qpos = self.limits[0], self.task, self.index.arm_qpos
-        self._qpos, self._dof = qpos, self.index.arm_dof
+        self._qpos, self._dof = _as_slice(qpos), _as_slice(self.index.arm_dof)
         self._reach = (limit.gain * limit.lower[qpos], limit.gain * limit.upper[qpos], limit.gain)
         self._weights = (task.cost * -task.gain, task.cost[:, None])
         self._velocity = np.zeros(self.model.nv)
-        self._eye = np.eye(len(qpos))
+        self._damping = DAMPING * np.eye(len(qpos))  # mink's, as its task adds none of its own
+        assert task.lm_damping == 0.0, "the frame task's own damping is not modelled here"
 
     def _set(self, arm_q: FloatArray) -> None:
         data = self.config.data
@@ -212,7 +214,7 @@ class LeanArmIK(ArmIK):
         target = np.empty(7)
         mujoco.mju_mat2Quat(target[:4], np.ascontiguousarray(rot, dtype=np.float64).ravel())
         target[4:] = pos
-        task.set_target(mink.SE3(wxyz_xyz=target))
+        task.transform_target_to_world = mink.SE3(wxyz_xyz=target)  # set_target, less a copy
         perr = rerr = np.inf
         for _ in range(iterations):
             err = task.compute_error(config)
@@ -242,13 +244,21 @@ class LeanArmIK(ArmIK):
         error_weights, jac_weights = self._weights
         error, weighted = error_weights * err, jac_weights * jac
         hessian = weighted.T @ weighted
-        hessian += self._eye * (DAMPING + self.task.lm_damping * float(error @ error))
-        step = np.asarray(np.linalg.solve(hessian, error @ weighted), dtype=np.float64)
+        hessian += self._damping
+        step: FloatArray = lapack.dgesv(hessian, error @ weighted)[2]  # as numpy.linalg.solve
         low, high, gain = self._reach
         moved = gain * self.config.data.qpos[self._qpos]
-        if ((step < low - moved) | (step > high - moved)).any():
+        if (step < low - moved).any() or (step > high - moved).any():
             return None
         return step
+
+
+def _as_slice(index: np.ndarray) -> slice | np.ndarray:
+    """A run of consecutive indices as a slice (cheaper to index with), else as it is."""
+    first = int(index[0])
+    if np.array_equal(index, np.arange(first, first + len(index))):
+        return slice(first, first + len(index))
+    return index
 
 
 # Start offsets for ArmIK.solve: as given, then wrist (joints 4 and 6) and elbow variations.
