@@ -112,11 +112,13 @@ class Scene:
             mine = np.array([names[b].startswith(f"hand_{finger}_") for b in model.geom_bodyid])
             group[mine & parts.robot] = finger_group(f)
         self.group = group
+        self._groups: list[int] = group.tolist()
+        self._nothing = [False] * model.ngeom
         _robot_contacts_only(model, parts.robot)
         self.root = model.body_rootid[model.geom_bodyid]  # each geom's top body
         self.held: tuple[Held, ...] = ()
         self._released: tuple[bytes, tuple[Held, ...]] = (b"", ())  # hand and grips last let go
-        self._carried: tuple[tuple[Held, ...], np.ndarray] = ((), np.zeros(model.ngeom, bool))
+        self._carried: tuple[tuple[Held, ...], list[bool]] = ((), [])
         arm_lo, arm_hi = robot.arm_range.T.copy()
         hand_lo, hand_hi = robot.hand_range.T.copy()
         self._limits = (arm_lo, arm_hi, hand_lo, hand_hi)
@@ -153,28 +155,28 @@ class Scene:
     # -- contacts ----------------------------------------------------------------------------------
     def _contacts(self, held: bool = True) -> list[tuple[int, int, float]]:
         """(robot geom, other geom, depth m) of every penetrating contact of the robot;
-        without ``held``, not those with what the hand holds."""
+        without ``held``, not those with what the hand holds. (A few contacts at most: a
+        loop over them is cheaper than array operations.)"""
         n = self.data.ncon
         if n == 0:
             return []
-        c, group = self.data.contact, self.group
-        g1, g2, dist = c.geom1[:n], c.geom2[:n], c.dist[:n]
-        keep = ((group[g1] >= 0) | (group[g2] >= 0)) & (dist < 0)
-        if not held and self.held:
-            carried = self._held_geoms()
-            keep &= ~(carried[g1] | carried[g2])
+        c, group = self.data.contact, self._groups
+        carried = self._held_geoms() if not held and self.held else self._nothing
+        g1, g2, dist = c.geom1[:n].tolist(), c.geom2[:n].tolist(), c.dist[:n].tolist()
         out = []
-        for a, b, d in zip(g1[keep].tolist(), g2[keep].tolist(), dist[keep].tolist(), strict=True):
+        for a, b, d in zip(g1, g2, dist, strict=True):
             ga, gb = group[a], group[b]
+            if d >= 0 or (ga < 0 and gb < 0) or carried[a] or carried[b]:
+                continue
             first = ga >= 0 and (gb < 0 or ga <= gb)  # the robot's geom first, the arm's first
             out.append((a, b, -d) if first else (b, a, -d))
         return out
 
-    def _held_geoms(self) -> np.ndarray:
+    def _held_geoms(self) -> list[bool]:
         """Whether each geom belongs to what the hand holds."""
         grips, mask = self._carried
         if grips is not self.held:
-            mask = np.isin(self.root, list(self.held_bodies()))
+            mask = np.isin(self.root, list(self.held_bodies())).tolist()
             self._carried = (self.held, mask)
         return mask
 
@@ -184,20 +186,20 @@ class Scene:
         out: set[int] = set()
         for a, b, _ in self._contacts(held):
             for mine, other in ((a, b), (b, a)):
-                if self.group[mine] in groups and self.group[other] not in groups:
+                if self._groups[mine] in groups and self._groups[other] not in groups:
                     out.add(other)
         return out
 
     def touching(self, groups: Collection[int], held: bool = True) -> bool:
         """Whether parts of ``groups`` touch the world or an object (not the robot; without
         ``held``, not what the hand holds)."""
-        return any(self.group[g] < 0 for g in self.touches(groups, held))
+        return any(self._groups[g] < 0 for g in self.touches(groups, held))
 
     def hits(self) -> list[Hit]:
         """The contacts that are problems (see docs/debugging.md), one per pair of parts."""
         out = []
         for a, b, depth in self._contacts(held=False):
-            ga, gb = int(self.group[a]), int(self.group[b])
+            ga, gb = self._groups[a], self._groups[b]
             if gb >= 0:  # the robot against itself (parent and child never collide)
                 if ga == gb or depth <= SELF_DEPTH:
                     continue
