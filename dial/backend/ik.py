@@ -200,6 +200,13 @@ class LeanArmIK(ArmIK):
         self._velocity = np.zeros(self.model.nv)
         self._damping = DAMPING * np.eye(len(qpos))  # mink's, as its task adds none of its own
         assert task.lm_damping == 0.0, "the frame task's own damping is not modelled here"
+        self._tools: dict[bytes, tuple[FloatArray, FloatArray]] = {}  # fk where tracks ended
+
+    def fk(self, arm_q: FloatArray) -> tuple[FloatArray, FloatArray]:
+        known = self._tools.get(np.asarray(arm_q, dtype=np.float64).tobytes())
+        if known is None:
+            return super().fk(arm_q)
+        return known[0].copy(), known[1].copy()
 
     def _set(self, arm_q: FloatArray) -> None:
         data = self.config.data
@@ -236,7 +243,16 @@ class LeanArmIK(ArmIK):
                 velocity = self._velocity
                 velocity[self._dof] = step / DT
             config.integrate_inplace(velocity, DT)
+        self._remember_tool()
         return perr, rerr
+
+    def _remember_tool(self) -> None:
+        """The tool pose where a track ended, for :meth:`fk` (a line's check asks for it)."""
+        if len(self._tools) > 10_000:
+            self._tools.clear()
+        data, site = self.config.data, self.index.tool_site
+        pose = (data.site_xpos[site].copy(), data.site_xmat[site].reshape(3, 3).copy())
+        self._tools[data.qpos[self._qpos].tobytes()] = pose
 
     def _step(self, err: FloatArray, jac: FloatArray) -> FloatArray | None:
         """The QP's unconstrained minimum (mink's weights, gain and damping); None if it

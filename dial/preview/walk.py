@@ -28,7 +28,7 @@ from dial.parser.ast import Condition
 from dial.parser.script import EventDef, Run, Script, Step, TBlock, TCall, TIf, TOn, TRepeat, Watch
 from dial.preview import checks
 from dial.preview.motions import PreviewPuma, Report, grasp, guarded, sense
-from dial.preview.places import Place
+from dial.preview.places import Place, Places
 from dial.preview.report import Counts, Problems
 from dial.preview.scene import Hit, Scene, State, finger_group
 from dial.primitives import CLASSES
@@ -93,6 +93,7 @@ class Walk:
         self.trace: list[FloatArray] = []
         self.ongoing: dict[tuple[str, str, str], tuple[Place, str]] = {}
         self.seen = (scene.robot.arm_target.copy(), scene.robot.hand_target.copy())
+        self.places = Places()  # statement places, the world files read once per preview
 
     # -- the timeline ------------------------------------------------------------------------------
     def steps(self, script: Script, steps: tuple[Step, ...], label: str) -> None:
@@ -276,7 +277,9 @@ class Walk:
         """The run's own primitive; ``puma_command``'s planned a statement at a time."""
         name = info.event.instruction.primitive
         ctx = self.scene.ctx
-        made = PreviewPuma(ctx, info) if name == "PumaCommand" else CLASSES[name](ctx, info)
+        if name == "PumaCommand":
+            return PreviewPuma(ctx, info, self.places)
+        made = CLASSES[name](ctx, info)
         assert isinstance(made, Primitive), "a fixed-length instruction has a primitive"
         return made
 
@@ -310,7 +313,7 @@ class Walk:
         """Look at the pose if it moved enough since it was last looked at."""
         arm, hand = self.scene.robot.arm_target, self.scene.robot.hand_target
         seen_arm, seen_hand = self.seen
-        if np.abs(arm - seen_arm).max() > ARM_STEP or (
+        if max(map(abs, (arm - seen_arm).tolist())) > ARM_STEP or (
             hand.tobytes() != seen_hand.tobytes()  # the hand seldom moves: compare it fast
             and np.abs(hand - seen_hand).max() > HAND_STEP
         ):
