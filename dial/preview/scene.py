@@ -17,7 +17,7 @@ import mujoco
 import numpy as np
 
 from dial.backend.driver import MujocoRobot
-from dial.backend.ik import FingerIK, LeanArmIK
+from dial.backend.ik import ArmIK, FingerIK, LeanArmIK
 from dial.backend.model import ARM_HOME, load_model, load_untextured
 from dial.backend.snapshot import FloatArray
 from dial.engine.setup import scene_bodies
@@ -102,7 +102,10 @@ class Scene:
         self.index = robot.index
         ik = LeanArmIK()  # the run's IK to rounding, faster; the fingers' on the same model
         pos, rot = home_pose(world, believed)
-        home = ik.solve(pos, rot, np.array(ARM_HOME), "the start pose (location 'home')")
+        # The start pose by the run's own IK: where a statement planned from it starts is
+        # then the run's to the bit (what a target out of reach reports depends on that).
+        what = "the start pose (location 'home')"
+        home = ArmIK(ik.model).solve(pos, rot, np.array(ARM_HOME), what)
         robot.arm_target = home
         self.ctx = Context(robot, world, believed, ik, FingerIK(copy.copy(ik.model)))
         self.parts = parts = Parts.of(model, robot.index)
