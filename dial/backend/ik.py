@@ -258,7 +258,7 @@ class LeanArmIK(ArmIK):
         low, high, gain = self._reach
         moved = gain * self.config.data.qpos[self._qpos]
         low, high = low - moved, high - moved
-        if (step < low).any() or (step > high).any():
+        if np.count_nonzero(step < low) or np.count_nonzero(step > high):
             return box_qp(hessian, gradient, low, high)
         return step
 

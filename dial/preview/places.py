@@ -15,6 +15,7 @@ from pathlib import Path
 from dial.scene.resolve import resolve_scene
 
 _TABLE = re.compile(r"^\s*\[\s*([^\[\]]+?)\s*\]\s*(#.*)?$")
+_EXTENDS = re.compile(r"^\s*(extends|\"extends\")\s*=")
 
 
 @dataclass(frozen=True)
@@ -43,10 +44,13 @@ class Places:
         self._chains: dict[Path, tuple[Path, ...]] = {}
         self._texts: dict[Path, list[str] | None] = {}
         self._keys: dict[tuple[Path, str], tuple[int, bool] | None] = {}
+        self._resolved: dict[Path, Path] = {}
 
     def statement(self, world: Path, program: str, line: int) -> str | None:
         """``FILE:LINE`` of line ``line`` of ``program`` in the world file that defines it."""
-        for path in self._chain(world.resolve()):
+        if world not in self._resolved:
+            self._resolved[world] = world.resolve()
+        for path in self._chain(self._resolved[world]):
             if (path, program) not in self._keys:
                 self._keys[path, program] = self._program_line(path, program)
             found = self._keys[path, program]
@@ -60,10 +64,7 @@ class Places:
         if path in self._chains:
             return self._chains[path]
         self._chains[path] = (path,)  # an extends cycle ends here (the loader reports it)
-        try:
-            data = tomllib.loads("\n".join(self._lines(path) or []))
-        except tomllib.TOMLDecodeError:
-            return (path,)
+        data = _extends(self._lines(path) or [])
         names = data.get("extends", [])
         names = [names] if isinstance(names, str) else names
         out = [path]
@@ -104,3 +105,22 @@ class Places:
                         return number, bool(value[3:].strip())
                 return number, True
         return None
+
+
+def _extends(lines: list[str]) -> dict[str, object]:
+    """The top-level ``extends`` of a world file's lines, as TOML reads it (``{}`` if none).
+
+    Top-level keys come before the first table, so only those lines are read; an array
+    value may span lines.
+    """
+    for i, text in enumerate(lines):
+        if _TABLE.match(text):
+            return {}
+        if _EXTENDS.match(text):
+            for j in range(i + 1, len(lines) + 1):  # the value may span lines
+                try:
+                    return tomllib.loads("\n".join(lines[i:j]))
+                except tomllib.TOMLDecodeError:
+                    continue
+            return {}
+    return {}

@@ -93,7 +93,7 @@ class Scene:
         load = load_model if textures else load_untextured
         self.model = model = load(world.model_path)
         self.data = data = mujoco.MjData(model)
-        mujoco.mj_forward(model, data)
+        mujoco.mj_kinematics(model, data)  # the objects' poses: all the preview reads
         believed = {
             model.body(b).name: (data.xpos[b].copy(), data.xmat[b].reshape(3, 3).copy())
             for b in scene_bodies(model, world)
@@ -314,7 +314,7 @@ class Scene:
         pos, rot = d.site_xpos[site], d.site_xmat[site].reshape(3, 3)
         tool = np.empty(4)
         mujoco.mju_mat2Quat(tool, d.site_xmat[site])
-        w, x, y, z = tool
+        w, x, y, z = tool.tolist()
         product = np.array([[w, -x, -y, -z], [x, w, -z, y], [y, z, w, -x], [z, -y, x, w]])
         for grip in self.held:  # positions and orientations in the tool frame, in the world
             d.qpos[grip.pos_adr] = (pos + grip.pos @ rot.T).ravel()
