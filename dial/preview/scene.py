@@ -107,7 +107,7 @@ class Scene:
         what = "the start pose (location 'home')"
         home = ArmIK(ik.model).solve(pos, rot, np.array(ARM_HOME), what)
         robot.arm_target = home
-        self.ctx = Context(robot, world, believed, ik, FingerIK(copy.copy(ik.model)))
+        self.ctx = Context(robot, world, believed, ik, _FingerIKOnDemand(ik.model))
         self.parts = parts = Parts.of(model, robot.index)
         names = [model.body(b).name for b in range(model.nbody)]
         group = np.where(parts.arm, ARM, np.where(parts.robot, PALM, -1))
@@ -331,6 +331,34 @@ class Scene:
         self.data.qpos[:] = state.qpos
         self.held = state.held
         self.pose()
+
+
+class _FingerIKOnDemand(FingerIK):
+    """The fingers' IK, on a copy of the arm's model, set up when a run first uses it (most
+    scripts never do)."""
+
+    def __init__(self, model: mujoco.MjModel) -> None:  # FingerIK's own waits for _ready
+        self._pending: mujoco.MjModel | None = model
+
+    def _ready(self) -> None:
+        if self._pending is not None:
+            model, self._pending = self._pending, None
+            super().__init__(copy.copy(model))
+
+    def tip(self, arm_q: FloatArray, hand_q: FloatArray, finger: int) -> FloatArray:
+        self._ready()
+        return super().tip(arm_q, hand_q, finger)
+
+    def track(
+        self,
+        finger: int,
+        tip: FloatArray,
+        arm_q: FloatArray,
+        hand_q: FloatArray,
+        iterations: int = 2,
+    ) -> FloatArray:
+        self._ready()
+        return super().track(finger, tip, arm_q, hand_q, iterations)
 
 
 def _robot_contacts_only(model: mujoco.MjModel, robot: np.ndarray) -> None:

@@ -13,6 +13,7 @@ from __future__ import annotations
 import math
 from abc import abstractmethod
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -56,9 +57,14 @@ class Segment:
         if x >= last:  # exactly the goal (a + (b - a) * 1 may be a bit off)
             return self.q1.copy()
         k = int(x)
-        a, b = self.waypoints[k], self.waypoints[k + 1]
-        out: FloatArray = a + (b - a) * (x - k)
+        out: FloatArray = self.waypoints[k] + self.steps[k] * (x - k)
         return out
+
+    @cached_property
+    def steps(self) -> FloatArray:
+        """(N, 6): each waypoint's difference to the next (b - a, worked out once)."""
+        steps: FloatArray = self.waypoints[1:] - self.waypoints[:-1]
+        return steps
 
 
 class Planner:
