@@ -64,10 +64,8 @@ class Held:
     """Bodies carried with the palm: their poses in the tool frame, and the grip holding them."""
 
     bodies: tuple[int, ...]
-    pos_adr: np.ndarray  # (3N,) qpos addresses of the bodies' free-joint positions
-    quat_adr: np.ndarray  # (4N,) and orientations
-    pos: FloatArray  # (N, 3) positions in the tool frame
-    quat: FloatArray  # (N, 4) orientations in the tool frame
+    adr: np.ndarray  # (7N,) qpos addresses of the bodies' free joints
+    local: FloatArray  # (N, 7) their positions and orientations (w, x, y, z) in the tool frame
     fingers: frozenset[int]
     closed: FloatArray  # (16,) the hand's joint angles when it closed
 
@@ -263,14 +261,13 @@ class Scene:
         m, d = self.model, self.data
         carried = sorted(set(bodies) | self._contents(bodies))
         pos, rot = self.tool()
-        adr = m.jnt_qposadr[m.body_jntadr[carried]][:, None] + np.arange(7)
-        pos_adr, quat_adr = adr[:, :3].ravel(), adr[:, 3:].ravel()
-        quat = np.empty((len(carried), 4))
+        adr = (m.jnt_qposadr[m.body_jntadr[carried]][:, None] + np.arange(7)).ravel()
+        local = np.empty((len(carried), 7))
+        local[:, :3] = (d.xpos[carried] - pos) @ rot
         for i, b in enumerate(carried):
-            mujoco.mju_mat2Quat(quat[i], (rot.T @ d.xmat[b].reshape(3, 3)).reshape(-1))
-        offsets = (d.xpos[carried] - pos) @ rot
+            mujoco.mju_mat2Quat(local[i, 3:], (rot.T @ d.xmat[b].reshape(3, 3)).reshape(-1))
         hand = self.robot.hand_target.copy()
-        grip = Held(tuple(carried), pos_adr, quat_adr, offsets, quat, frozenset(fingers), hand)
+        grip = Held(tuple(carried), adr, local, frozenset(fingers), hand)
         self.held = (*self.held, grip)
 
     def _contents(self, bodies: Collection[int]) -> set[int]:
@@ -310,15 +307,19 @@ class Scene:
         self._released = (flex.tobytes(), self.held)
 
     def _carry(self) -> None:
+        """Pose what the hand holds: (N, 7) tool-frame poses times one 7 x 7 block matrix,
+        the tool's rotation for positions and its quaternion product for orientations."""
         d, site = self.data, self.index.tool_site
-        pos, rot = d.site_xpos[site], d.site_xmat[site].reshape(3, 3)
         tool = np.empty(4)
         mujoco.mju_mat2Quat(tool, d.site_xmat[site])
         w, x, y, z = tool.tolist()
-        product = np.array([[w, -x, -y, -z], [x, w, -z, y], [y, z, w, -x], [z, -y, x, w]])
-        for grip in self.held:  # positions and orientations in the tool frame, in the world
-            d.qpos[grip.pos_adr] = (pos + grip.pos @ rot.T).ravel()
-            d.qpos[grip.quat_adr] = (grip.quat @ product.T).ravel()
+        block = np.zeros((7, 7))
+        block[:3, :3] = d.site_xmat[site].reshape(3, 3).T
+        block[3:, 3:] = ((w, x, y, z), (-x, w, z, -y), (-y, -z, w, x), (-z, y, -x, w))
+        shift = np.zeros(7)
+        shift[:3] = d.site_xpos[site]
+        for grip in self.held:
+            d.qpos[grip.adr] = (grip.local @ block + shift).ravel()
 
     # -- branches ----------------------------------------------------------------------------------
     def save(self) -> State:
