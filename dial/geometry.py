@@ -75,6 +75,10 @@ def slerp(r0: FloatArray, r1: FloatArray, u: float) -> FloatArray:
     return Slerp(r0, r1)(u)
 
 
+_EYE = np.eye(3)
+_EYE.flags.writeable = False
+
+
 class Slerp:
     """Rotations between ``r0`` and ``r1`` about their relative axis, the axis found once."""
 
@@ -96,7 +100,7 @@ class Slerp:
         if self.angle < 1e-9:
             return self.r0.copy()
         a = self.angle * u
-        step = np.eye(3) + np.sin(a) * self.k + (1.0 - np.cos(a)) * self.kk
+        step = _EYE + np.sin(a) * self.k + (1.0 - np.cos(a)) * self.kk
         out: FloatArray = self.r0 @ step
         return out
 

@@ -123,6 +123,7 @@ class Scene:
         arm_lo, arm_hi = robot.arm_range.T.copy()
         hand_lo, hand_hi = robot.hand_range.T.copy()
         self._limits = (arm_lo, arm_hi, hand_lo, hand_hi)
+        self._qpos, self._tool_xpos = data.qpos, data.site_xpos[robot.index.tool_site]  # views
         self.pose()
 
     # -- posing ------------------------------------------------------------------------------------
@@ -131,8 +132,9 @@ class Scene:
         m, d, ix, r = self.model, self.data, self.index, self.robot
         arm_lo, arm_hi, hand_lo, hand_hi = self._limits
         # The servos stop at the joint limits (a target beyond one is reported by the checks).
-        d.qpos[ix.arm_qpos] = np.minimum(np.maximum(r.arm_target, arm_lo), arm_hi)
-        d.qpos[ix.hand_qpos] = np.minimum(np.maximum(r.hand_target, hand_lo), hand_hi)
+        qpos = self._qpos
+        qpos[ix.arm_qpos] = np.minimum(np.maximum(r.arm_target, arm_lo), arm_hi)
+        qpos[ix.hand_qpos] = np.minimum(np.maximum(r.hand_target, hand_lo), hand_hi)
         mujoco.mj_kinematics(m, d)
         if self.held:
             self._let_go()
@@ -146,7 +148,7 @@ class Scene:
         return self.data.site_xpos[site].copy(), self.data.site_xmat[site].reshape(3, 3).copy()
 
     def tool_position(self) -> FloatArray:
-        position: FloatArray = self.data.site_xpos[self.index.tool_site].copy()
+        position: FloatArray = self._tool_xpos.copy()
         return position
 
     def tip(self, finger: int) -> FloatArray:
