@@ -78,8 +78,9 @@ class Panel:
 class Walk:
     """Walks a script's timeline over a :class:`Scene`; collects problems and panels."""
 
-    def __init__(self, scene: Scene, periods_per_tick: int) -> None:
-        self.scene, self.n = scene, periods_per_tick
+    def __init__(self, scene: Scene, periods_per_tick: int, traces: bool = True) -> None:
+        """``traces``: keep the tool's path through each block (only a storyboard draws it)."""
+        self.scene, self.n, self.traces = scene, periods_per_tick, traces
         self.problems = Problems()
         self.counts = Counts()
         self.panels: list[Panel] = []
@@ -327,7 +328,8 @@ class Walk:
         """Record the posed scene's problems, each on the run that caused it."""
         robot = self.scene.robot
         self.seen = (robot.arm_target.copy(), robot.hand_target.copy())
-        self.trace.append(self.scene.tool_position())
+        if self.traces:
+            self.trace.append(self.scene.tool_position())
         ongoing: dict[tuple[str, str, str], tuple[Place, str]] = {}
         for hit in self.scene.hits():
             # A contact that goes on from the last look stays with the run that made it.
