@@ -124,6 +124,7 @@ class Scene:
         hand_lo, hand_hi = robot.hand_range.T.copy()
         self._limits = (arm_lo, arm_hi, hand_lo, hand_hi)
         self._qpos, self._tool_xpos = data.qpos, data.site_xpos[robot.index.tool_site]  # views
+        self._hand = b""  # the hand set-points in qpos
         self.pose()
 
     # -- posing ------------------------------------------------------------------------------------
@@ -134,7 +135,10 @@ class Scene:
         # The servos stop at the joint limits (a target beyond one is reported by the checks).
         qpos = self._qpos
         qpos[ix.arm_qpos] = np.minimum(np.maximum(r.arm_target, arm_lo), arm_hi)
-        qpos[ix.hand_qpos] = np.minimum(np.maximum(r.hand_target, hand_lo), hand_hi)
+        hand = r.hand_target.tobytes()
+        if hand != self._hand:  # the hand seldom moves
+            qpos[ix.hand_qpos] = np.minimum(np.maximum(r.hand_target, hand_lo), hand_hi)
+            self._hand = hand
         mujoco.mj_kinematics(m, d)
         if self.held:
             self._let_go()
@@ -332,6 +336,7 @@ class Scene:
         self.robot.arm_target = state.arm.copy()
         self.robot.hand_target = state.hand.copy()
         self.data.qpos[:] = state.qpos
+        self._hand = b""
         self.held = state.held
         self.pose()
 
