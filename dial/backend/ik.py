@@ -7,13 +7,11 @@ one: a straight-line move solves one waypoint per control period.
 
 from __future__ import annotations
 
-import math
 from collections import OrderedDict
 
 import mink
 import mujoco
 import numpy as np
-from scipy.linalg import lapack
 
 from dial.backend.model import RobotIndex, load_model
 from dial.backend.snapshot import FloatArray
@@ -24,7 +22,6 @@ DT = 0.01  # s: the differential step of one solve
 POS_TOL = 5e-4  # m
 ROT_TOL = 2e-3  # rad
 SOLVE_ITERATIONS = 200  # per start of ArmIK.solve
-LEAN_ITERATIONS = 30  # per start of LeanArmIK.solve, before it leaves one to mink
 DAMPING = 1e-3  # mink's Levenberg-Marquardt damping of every step
 
 
@@ -175,136 +172,6 @@ class ArmIK(_Base):
             f"{what} is out of the arm's reach: the tool stays {closest[0] * 1000:.1f} mm "
             f"and {np.degrees(closest[1]):.1f} deg away"
         )
-
-
-class LeanArmIK(ArmIK):
-    """:class:`ArmIK` with mink's QP solved directly, for ``dial preview``.
-
-    mink builds and solves a QP for each step of :meth:`ArmIK._iterate`: the frame task's
-    damped least squares, the hand frozen, the arm inside its joint limits. Here the same QP,
-    from mink's own task error and Jacobian, is solved over the six arm joints: one 6 x 6
-    linear solve while no limit binds, else :func:`box_qp`. So a step, a track (a line's
-    waypoint) and a solve (a target) equal ArmIK's to rounding (1e-10 rad on the bundled
-    scripts), for a fifth of the cost. A start of :meth:`ArmIK.solve` that has not
-    converged after :data:`LEAN_ITERATIONS` is left to mink from its beginning, so that a
-    target out of reach fails as in the run. Memoized apart from ArmIK, so that a run never
-    reads these answers.
-    """
-
-    MEMO = "lean-arm"
-
-    def __init__(self, model: mujoco.MjModel | None = None) -> None:
-        super().__init__(model)
-        limit, task, qpos = self.limits[0], self.task, self.index.arm_qpos
-        self._qpos, self._dof = _as_slice(qpos), _as_slice(self.index.arm_dof)
-        self._reach = (limit.gain * limit.lower[qpos], limit.gain * limit.upper[qpos], limit.gain)
-        self._weights = (task.cost * -task.gain, task.cost[:, None])
-        self._velocity = np.zeros(self.model.nv)
-        self._damping = DAMPING * np.eye(len(qpos))  # mink's, as its task adds none of its own
-        assert task.lm_damping == 0.0, "the frame task's own damping is not modelled here"
-        self._tools: dict[bytes, tuple[FloatArray, FloatArray]] = {}  # fk where tracks ended
-
-    def fk(self, arm_q: FloatArray) -> tuple[FloatArray, FloatArray]:
-        known = self._tools.get(np.asarray(arm_q, dtype=np.float64).tobytes())
-        if known is None:
-            return super().fk(arm_q)
-        return known[0].copy(), known[1].copy()
-
-    def _set(self, arm_q: FloatArray) -> None:
-        data = self.config.data
-        if data.qpos[self._qpos].tobytes() != np.asarray(arm_q, dtype=np.float64).tobytes():
-            data.qpos[self._qpos] = arm_q
-            self.config.update()
-
-    def _iterate(self, pos: FloatArray, rot: FloatArray, iterations: int) -> tuple[float, float]:
-        task, config = self.task, self.config
-        target = np.empty(7)
-        mujoco.mju_mat2Quat(target[:4], np.ascontiguousarray(rot, dtype=np.float64).ravel())
-        target[4:] = pos
-        task.transform_target_to_world = mink.SE3(wxyz_xyz=target)  # set_target, less a copy
-        start = config.data.qpos.copy()
-        perr = rerr = np.inf
-        for _ in range(min(iterations, LEAN_ITERATIONS)):
-            err = task.compute_error(config)
-            perr, rerr = math.sqrt(err[:3].dot(err[:3])), math.sqrt(err[3:].dot(err[3:]))
-            if perr < POS_TOL and rerr < ROT_TOL:
-                break
-            step = self._step(err, task.compute_jacobian(config)[:, self._dof])
-            self._velocity[self._dof] = step / DT
-            config.integrate_inplace(self._velocity, DT)
-        else:
-            if iterations > LEAN_ITERATIONS:  # a solve that does not converge soon: mink's
-                config.update(start)
-                return super()._iterate(pos, rot, iterations)
-        self._remember_tool()
-        return perr, rerr
-
-    def _remember_tool(self) -> None:
-        """The tool pose where a track ended, for :meth:`fk` (a line's check asks for it)."""
-        if len(self._tools) > 10_000:
-            self._tools.clear()
-        data, site = self.config.data, self.index.tool_site
-        pose = (data.site_xpos[site].copy(), data.site_xmat[site].reshape(3, 3).copy())
-        self._tools[data.qpos[self._qpos].tobytes()] = pose
-
-    def _step(self, err: FloatArray, jac: FloatArray) -> FloatArray:
-        """The step mink's QP takes (its weights, gain, damping and joint-limit bounds)."""
-        error_weights, jac_weights = self._weights
-        error, weighted = error_weights * err, jac_weights * jac
-        hessian = weighted.T @ weighted
-        hessian += self._damping
-        gradient = error @ weighted
-        step: FloatArray = lapack.dgesv(hessian, gradient)[2]  # as numpy.linalg.solve
-        low, high, gain = self._reach
-        moved = gain * self.config.data.qpos[self._qpos]
-        low, high = low - moved, high - moved
-        if np.count_nonzero(step < low) or np.count_nonzero(step > high):
-            return box_qp(hessian, gradient, low, high)
-        return step
-
-
-def box_qp(hessian: FloatArray, b: FloatArray, low: FloatArray, high: FloatArray) -> FloatArray:
-    """argmin 1/2 x'Hx - b'x with ``low <= x <= high`` (H positive definite; low <= high).
-
-    A primal active-set method: from a feasible point, solve for the free variables with the
-    bound ones held; step toward that solution until a bound blocks (it joins the bound set);
-    at a solution, free the bound variable whose multiplier has the wrong sign, if any.
-    Exact to rounding: daqp, mink's QP solver, agrees to 1e-14.
-    """
-    n = len(b)
-    x = np.minimum(np.maximum(np.zeros(n), low), high)
-    side = np.zeros(n, dtype=np.int8)  # -1 held at its low bound, +1 at its high one, 0 free
-    for _ in range(10 * n):
-        free, held = np.flatnonzero(side == 0), np.flatnonzero(side != 0)
-        goal = x.copy()
-        if len(free):
-            rhs = b[free] - hessian[np.ix_(free, held)] @ x[held]
-            goal[free] = np.linalg.solve(hessian[np.ix_(free, free)], rhs)
-        way = goal - x
-        with np.errstate(divide="ignore", invalid="ignore"):
-            room = np.where(way < 0, (low - x) / way, np.where(way > 0, (high - x) / way, np.inf))
-        room[held] = np.inf
-        block = int(np.argmin(room))
-        if room[block] < 1.0:  # a bound blocks the way: go to it, hold the variable there
-            x += room[block] * way
-            x[block] = low[block] if way[block] < 0 else high[block]
-            side[block] = -1 if way[block] < 0 else 1
-            continue
-        x = goal
-        force = hessian @ x - b  # the multipliers of the held bounds
-        wrong = np.flatnonzero(((side < 0) & (force < 0)) | ((side > 0) & (force > 0)))
-        if not len(wrong):
-            return x
-        side[wrong[np.argmax(np.abs(force[wrong]))]] = 0
-    raise ArithmeticError("the step's QP did not settle")  # finite for a convex QP
-
-
-def _as_slice(index: np.ndarray) -> slice | np.ndarray:
-    """A run of consecutive indices as a slice (cheaper to index with), else as it is."""
-    first = int(index[0])
-    if np.array_equal(index, np.arange(first, first + len(index))):
-        return slice(first, first + len(index))
-    return index
 
 
 # Start offsets for ArmIK.solve: as given, then wrist (joints 4 and 6) and elbow variations.

@@ -9,7 +9,6 @@ any free body inside it (the pitcher's balls), until the hand opens the gripping
 
 from __future__ import annotations
 
-import copy
 from collections.abc import Collection
 from dataclasses import dataclass
 
@@ -17,11 +16,12 @@ import mujoco
 import numpy as np
 
 from dial.backend.driver import MujocoRobot
-from dial.backend.ik import ArmIK, FingerIK, LeanArmIK
+from dial.backend.ik import ArmIK
 from dial.backend.model import ARM_HOME, load_model, load_untextured
 from dial.backend.snapshot import FloatArray
 from dial.engine.setup import scene_bodies
 from dial.instructions.types import FINGERS
+from dial.preview.ik import FingerIKOnDemand, LeanArmIK
 from dial.primitives import Context
 from dial.scene.world import World
 from dial.teach.contacts import FIXED_DEPTH, OBJECT_DEPTH, Parts
@@ -105,7 +105,7 @@ class Scene:
         what = "the start pose (location 'home')"
         home = ArmIK(ik.model).solve(pos, rot, np.array(ARM_HOME), what)
         robot.arm_target = home
-        self.ctx = Context(robot, world, believed, ik, _FingerIKOnDemand(ik.model))
+        self.ctx = Context(robot, world, believed, ik, FingerIKOnDemand(ik.model))
         self.parts = parts = Parts.of(model, robot.index)
         names = [model.body(b).name for b in range(model.nbody)]
         group = np.where(parts.arm, ARM, np.where(parts.robot, PALM, -1))
@@ -339,34 +339,6 @@ class Scene:
         self._hand = b""
         self.held = state.held
         self.pose()
-
-
-class _FingerIKOnDemand(FingerIK):
-    """The fingers' IK, on a copy of the arm's model, set up when a run first uses it (most
-    scripts never do)."""
-
-    def __init__(self, model: mujoco.MjModel) -> None:  # FingerIK's own waits for _ready
-        self._pending: mujoco.MjModel | None = model
-
-    def _ready(self) -> None:
-        if self._pending is not None:
-            model, self._pending = self._pending, None
-            super().__init__(copy.copy(model))
-
-    def tip(self, arm_q: FloatArray, hand_q: FloatArray, finger: int) -> FloatArray:
-        self._ready()
-        return super().tip(arm_q, hand_q, finger)
-
-    def track(
-        self,
-        finger: int,
-        tip: FloatArray,
-        arm_q: FloatArray,
-        hand_q: FloatArray,
-        iterations: int = 2,
-    ) -> FloatArray:
-        self._ready()
-        return super().track(finger, tip, arm_q, hand_q, iterations)
 
 
 def _robot_contacts_only(model: mujoco.MjModel, robot: np.ndarray) -> None:
