@@ -9,8 +9,10 @@ Prints:
   the pairs' ratios is the figure, the best run over the best replay is printed beside it,
   and the ratio of process CPU times. mj_step's own speed drifts by 10-20 % over seconds on a
   shared machine, so a run and a replay seconds apart can disagree by that much; the ratio
-  of a run's wall time to the time it spent inside mj_step (timed call by call) is measured
-  within one span and is the steadiest figure.
+  of a run's wall time to the time it spent inside mj_step (timed call by call, in a run of
+  its own after each pair, as the timing costs time too) is measured within one span and is
+  the steadiest figure; it leaves out what dial's work between physics steps costs the
+  physics (its data pushed out of the caches), which the pairs include.
   A loop from the scene's rest state, which the robot never disturbs, is printed beside it;
 - the run's real-time factor (goal for pour.dial: >= 20 on one core);
 - for a script in the pour scene, the bare physics of that run per simulated second beside
@@ -131,13 +133,14 @@ def engine_overhead(script_arg: str | Script, repeat: int) -> tuple[World, _Repl
     # Interleaved pairs, so that a noisy neighbour slows a run and its replay alike.
     walls, replays, cpu_ratios, inside = [], [], [], []
     for _ in range(repeat):
-        timer = _StepTimer()
-        result = _run_with(timer, script)
-        inside.append(result.wall_time / timer.seconds)
+        result = _run_with(mujoco, script)  # as dial run runs: nothing timed inside
         bare_wall, bare_cpu = replay.run()
         walls.append(result.wall_time)
         replays.append(bare_wall)
         cpu_ratios.append(result.cpu_time / bare_cpu)
+        timer = _StepTimer()  # a run of its own: timing each call costs time too
+        timed = _run_with(timer, script)
+        inside.append(timed.wall_time / timer.seconds)
     same = np.array_equal(data.qpos, np.array(result.final_qpos))
     steps = result.physics_steps
     rest = mujoco.MjData(model)

@@ -70,6 +70,13 @@ def smooth(u: float) -> float:
     return u * u * u * (10.0 - 15.0 * u + 6.0 * u * u)
 
 
+def smooth_array(u: FloatArray) -> FloatArray:
+    """:func:`smooth` of each element, bit for bit (the same operations in the same order)."""
+    u = np.minimum(1.0, np.maximum(0.0, u))
+    out: FloatArray = u * u * u * (10.0 - 15.0 * u + 6.0 * u * u)
+    return out
+
+
 def slerp(r0: FloatArray, r1: FloatArray, u: float) -> FloatArray:
     """Rotation between ``r0`` and ``r1`` (u in [0, 1]) about their relative axis."""
     return Slerp(r0, r1)(u)

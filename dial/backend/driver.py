@@ -10,11 +10,12 @@ period. The driver writes no log: it reports what happened, and the runner recor
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from dataclasses import replace
 
 import mujoco
 import numpy as np
+from numpy.typing import NDArray
 
 from dial.backend.disturb import Disturbances
 from dial.backend.guards import Guard, Guards, Readings
@@ -25,7 +26,8 @@ from dial.backend.snapshot import FloatArray, Snapshot, Trip, frozen
 from dial.instructions.catalogue import contact_condition
 from dial.instructions.types import FINGERS
 from dial.scene.thread import Thread, find_threads
-from dial.scheduler.types import Fired, Happening, Monitor, Report
+from dial.scheduler.signals import StopRequest
+from dial.scheduler.types import Course, Fired, Happening, Monitor, Report, advance_through
 
 CONTROL_PERIOD = 0.01  # s; physics runs at the model's timestep (0.002 s)
 
@@ -56,7 +58,8 @@ class MujocoRobot:
         self.steps = 0
         self.arm_target = data.qpos[ix.arm_qpos].copy()
         self.hand_target = data.qpos[ix.hand_qpos].copy()
-        self.limp = np.zeros(16, dtype=bool)
+        self.limp = np.zeros(16, dtype=bool)  # written through set_limp
+        self._limping = False  # any limp joint: read every period, kept up to date
         self.threads: tuple[Thread, ...] = find_threads(model)
         self.guards = Guards()
         self.monitors: set[int] = set()  # keys of guards that are monitors (freeze nothing)
@@ -67,7 +70,7 @@ class MujocoRobot:
         self._tactile_adr = [int(a) for a in ix.tactile_sensors]
         # The four arrays' sensordata, in one fancy index: one copy per snapshot, not four.
         self._tactile_idx = np.concatenate([np.arange(a, a + 256) for a in self._tactile_adr])
-        self.safety = Safety(model, data, ix)
+        self.safety = Safety(model, data, ix, self._period)
         self._readings = Readings(data, ix, self._tactile_adr)
         # Control addresses as slices where they run in order (they do in dial's models):
         # writing a slice costs a fraction of writing through an index array.
@@ -171,11 +174,37 @@ class MujocoRobot:
         self._fired.clear()
         return report
 
+    def coast(
+        self, writes: Sequence[Course], periods: int, stop: StopRequest
+    ) -> tuple[int, Report | None]:
+        """``advance`` up to ``periods`` times, each after writing that period's set-points
+        (``write(k)`` for the k-th); it returns after a period that reports anything, or a
+        stop signal, with the number of periods taken. With no guard, thread or disturbance
+        in the way this is :meth:`advance` unrolled, as lean as a period can be."""
+        n = self.substeps
+        if self.guards or self.threads or self.disturbances.due(self.steps, periods * n):
+            return advance_through(self, writes, periods, stop)
+        m, d, safety, happened = self.model, self.data, self.safety, self._happened
+        for k in range(periods):
+            for write in writes:
+                write(k)
+            self._apply()
+            mujoco.mj_step(m, d, nstep=n)
+            self.steps += n
+            fault = safety.check(self.steps * self._dt, happened)
+            if fault is not None or happened:
+                report = Report(fault, tuple(happened))
+                happened.clear()
+                return k + 1, report
+            if stop.signal is not None:
+                return k + 1, None
+        return periods, None
+
     def hold_all(self) -> None:
         ix = self.index
         self.arm_target = self.data.qpos[ix.arm_qpos].copy()
         self.hand_target = self.data.qpos[ix.hand_qpos].copy()
-        self.limp[:] = False
+        self.set_limp(slice(None), False)
         self.guards.clear()
         self.monitors.clear()
         self._apply()
@@ -189,7 +218,7 @@ class MujocoRobot:
             if finger in effectors:
                 joints = slice(4 * f, 4 * f + 4)
                 self.hand_target[joints] = self.data.qpos[ix.hand_qpos[joints]]
-                self.limp[joints] = False
+                self.set_limp(joints, False)
         self._apply()
 
     def arm(self, monitor: Monitor) -> int:
@@ -207,6 +236,11 @@ class MujocoRobot:
         self._trips.pop(key, None)
 
     # -- what primitives may ask of the robot (through Slots, or read-only) ----------------------
+    def set_limp(self, joints: slice | list[int], on: bool | NDArray[np.bool_]) -> None:
+        """Make these hand joints (mask order) back-drivable, or stiff."""
+        self.limp[joints] = on
+        self._limping = bool(self.limp.any())
+
     def measured_hand(self) -> FloatArray:
         """(16,) hand joint angles now (rad, mask order)."""
         return np.asarray(self.data.qpos[self.index.hand_qpos], dtype=np.float64)
@@ -237,7 +271,7 @@ class MujocoRobot:
         d = self.data
         d.ctrl[self._arm_ctrl] = self.arm_target
         target = self.hand_target
-        if self.limp.any():  # limp joints follow their measured angle
+        if self._limping:  # limp joints follow their measured angle
             target = np.where(self.limp, d.qpos[self.index.hand_qpos], target)
         if self._tendon_pairs is not None:
             self._tendon_pairs[:] = target[:, None]

@@ -10,13 +10,13 @@ and a wait mean the same contact.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import mujoco
 import numpy as np
 
 from dial.backend.contact import POSITION_LEVER
-from dial.backend.model import RobotIndex, tendon_differentials
+from dial.backend.model import RobotIndex, tendon_tensions
 from dial.backend.snapshot import FloatArray, Trip
 
 
@@ -30,6 +30,10 @@ class Guard:
     sense: tuple[int, ...]
     baseline: FloatArray  # (16,) differentials when armed, for force conditions
     negated: bool = False
+    floats: tuple[float, ...] = field(init=False, repr=False)  # baseline, read every step
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "floats", tuple(self.baseline.tolist()))
 
 
 class Readings:
@@ -39,13 +43,20 @@ class Readings:
     robot: :meth:`at_step` starts each step afresh."""
 
     __slots__ = (
-        "_data", "_dev", "_diff", "_dropped", "_index", "_q", "_tactile", "_target", "_tensions"
+        "_all", "_data", "_diff", "_dropped", "_index", "_q", "_tactile", "_target",
+        "_tensions", "_tips",
     )  # fmt: skip
 
     def __init__(self, data: mujoco.MjData, index: RobotIndex, tactile_adr: Sequence[int]) -> None:
         self._data, self._index = data, index
         # Views into sensordata stay valid for the data's life: slicing once saves a lot.
         self._tactile = [data.sensordata[a : a + 256] for a in tactile_adr]
+        # The four arrays as one (4, 256) view where they follow each other (they do in
+        # dial's models): a guard sensing every finger then reads four maxima in one call.
+        first = int(tactile_adr[0])
+        together = list(tactile_adr) == [first + 256 * f for f in range(len(tactile_adr))]
+        self._all = data.sensordata[first : first + 1024].reshape(4, 256) if together else None
+        self._tips: list[float] | None = None
         adr = index.tension_sensors
         first = int(adr[0])
         # The 32 tensions as a view where they run in order (flexor, extensor per joint).
@@ -53,39 +64,33 @@ class Readings:
         self._tensions = data.sensordata[first : first + len(adr)] if in_order else None
         self._target: FloatArray = np.zeros(16)
         self._dropped: frozenset[tuple[str, int]] = frozenset()
-        # Per guard baseline (by id, for this step): each finger's largest |change| (N).
-        self._dev: dict[int, list[float]] = {}
-        self._diff: FloatArray | None = None
+        self._diff: list[float] | None = None  # this step's 32 tensions (flexor, extensor)
         self._q: FloatArray | None = None
 
     def at_step(self, target: FloatArray, dropped: frozenset[tuple[str, int]]) -> Readings:
         self._target, self._dropped = target, dropped
-        self._diff = self._q = None
-        if self._dev:
-            self._dev = {}
+        self._diff = self._q = self._tips = None
         return self
 
-    def value(self, kind: str, f: int, baseline: FloatArray) -> float:
+    def value(self, kind: str, f: int, baseline: Sequence[float]) -> float:
         """The reading of contact ``kind`` on finger ``f``: m (tactile, position) or N."""
         if self._dropped and (kind, f) in self._dropped:
             return 0.0
         if kind == "tactile":
-            return float(self._tactile[f].max())
+            if self._all is None:
+                return float(self._tactile[f].max())
+            if self._tips is None:  # once per step, whatever the guards and fingers
+                self._tips = self._all.max(axis=1).tolist()
+            return self._tips[f]
         if kind == "force":
-            # All four fingers at once, once per guard and step: a monitor on two fingers,
-            # or two monitors, cost one array expression instead of one per finger.
-            dev = self._dev.get(id(baseline))
-            if dev is None:
-                if self._diff is None:  # once per step, whatever the number of guards
-                    t = self._tensions
-                    self._diff = (
-                        t[0::2] - t[1::2]
-                        if t is not None
-                        else tendon_differentials(self._data, self._index)
-                    )
-                dev = np.abs(self._diff - baseline).reshape(4, 4).max(axis=1).tolist()
-                self._dev[id(baseline)] = dev
-            return dev[f]
+            # The largest change of a finger's four differentials since the guard was armed,
+            # in Python floats: the tensions are read once per step, whatever the guards.
+            if self._diff is None:
+                view = self._tensions
+                tensions = view if view is not None else tendon_tensions(self._data, self._index)
+                self._diff = tensions.tolist()
+            t: list[float] = self._diff
+            return max(abs(t[2 * k] - t[2 * k + 1] - baseline[k]) for k in range(4 * f, 4 * f + 4))
         if self._q is None:
             self._q = self._data.qpos[self._index.hand_qpos]
         joints = slice(4 * f, 4 * f + 4)
@@ -102,7 +107,7 @@ def first_trip(guard: Guard, r: Readings, time: float, step: int) -> Trip | None
     first: tuple[str, int, float] | None = None
     for kind, threshold in guard.conditions:
         for f in guard.sense:
-            value = r.value(kind, f, guard.baseline)
+            value = r.value(kind, f, guard.floats)
             if value >= threshold:
                 return None if guard.negated else Trip(time, step, kind, f, value)
             if first is None:

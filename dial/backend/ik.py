@@ -70,6 +70,18 @@ class _Memo:
 _MEMO = _Memo()
 
 
+def recall(kind: str, *parts: object) -> tuple[tuple[object, ...], object]:
+    """The memo's key for a result computed from these exact inputs, and the result if one
+    is known (else None): for results built from solves, such as a line's waypoints."""
+    key = _Memo.key(kind, *parts)
+    return key, _MEMO.get(key)
+
+
+def remember(key: tuple[object, ...], value: object) -> None:
+    """Keep ``value`` under ``key`` (from :func:`recall`)."""
+    _MEMO.put(key, value)
+
+
 def forget_solutions() -> None:
     """Empty the memo: the next solves cost what they cost in a fresh process (benchmarks)."""
     _MEMO.clear()

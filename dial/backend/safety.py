@@ -26,10 +26,16 @@ _DIVERGENCE = (
 class Safety:
     """The safety monitors of one robot."""
 
-    def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, index: RobotIndex) -> None:
+    def __init__(
+        self, model: mujoco.MjModel, data: mujoco.MjData, index: RobotIndex, period: float
+    ) -> None:
         self.data, self.index = data, index
         # Views of MuJoCo's warning counters, looked up once: they follow data.warning.
         self._divergence = [data.warning[w] for w in _DIVERGENCE]
+        # A reset sets the time to 0, so a period ends before this (reading the counters
+        # costs more than reading the time): at most period - 1 step after the reset.
+        self._span = period - 0.5 * float(model.opt.timestep)
+        self._due = data.time + self._span
         arm_range = model.jnt_range[model.actuator_trnid[index.arm_actuators, 0]]
         self._arm_lo = arm_range[:, 0] - LIMIT_SLACK
         self._arm_hi = arm_range[:, 1] + LIMIT_SLACK
@@ -48,17 +54,21 @@ class Safety:
         ix = self.index
         # MuJoCo resets the state itself when it meets a bad qacc/qpos/qvel, and counts a
         # warning: a nonzero count is the divergence (the state is no longer the run's).
-        for warning in self._divergence:
-            if warning.number:
-                return "the physics diverged (MuJoCo reset an unstable state)"
-        q = self._arm_q().tolist()
-        for j, ((lo, hi), angle) in enumerate(zip(self._arm_bounds, q, strict=True)):
+        now = self.data.time
+        if now < self._due:
+            for warning in self._divergence:
+                if warning.number:
+                    return "the physics diverged (MuJoCo reset an unstable state)"
+        self._due = now + self._span
+        for (lo, hi), angle in zip(self._arm_bounds, self._arm_q().tolist(), strict=True):
             if not lo <= angle <= hi:
-                return f"PUMA joint {j + 1} is beyond its limit ({np.degrees(angle):.1f} deg)"
+                return self._beyond()
         # A tendon pinned at its limit is not a fault (a fist pressed into the palm does it),
         # but a researcher should know: log it once per episode.
         tensions = self._tensions()
-        if not self._tracking and tensions.max() < self._pinned_at:  # the common case
+        # The common case. Python's max of a list: numpy's reduction machinery costs several
+        # times more just after a physics step has filled the caches with its own data.
+        if not self._tracking and max(tensions.tolist()) < self._pinned_at:
             return None
         pinned = tensions >= self._pinned_at
         if not pinned.any() and not self.saturation_logged.any():
@@ -79,6 +89,13 @@ class Safety:
             happened.append(Happening("warning", {"t": time, "message": message}))
         self.saturation_logged = held | (self.saturation_logged & pinned)
         return None
+
+    def _beyond(self) -> str:
+        """The fault message of the first arm joint beyond its limit."""
+        q = self._arm_q().tolist()
+        bounds = enumerate(zip(self._arm_bounds, q, strict=True))
+        j = next(j for j, ((lo, hi), angle) in bounds if not lo <= angle <= hi)
+        return f"PUMA joint {j + 1} is beyond its limit ({np.degrees(q[j]):.1f} deg)"
 
 
 def _view(array: np.ndarray, index: np.ndarray) -> Callable[[], np.ndarray]:

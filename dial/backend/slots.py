@@ -10,6 +10,7 @@ import numpy as np
 from dial.backend.snapshot import FloatArray
 from dial.errors import DialError
 from dial.instructions.types import FINGERS
+from dial.scheduler.types import Course
 
 
 class EffectorError(DialError):
@@ -21,7 +22,9 @@ class Commanded(Protocol):
 
     arm_target: FloatArray  # (6,) rad
     hand_target: FloatArray  # (16,) rad, mask order
-    limp: np.ndarray  # (16,) bool
+    limp: np.ndarray  # (16,) bool, written through set_limp
+
+    def set_limp(self, joints: list[int], on: bool) -> None: ...
 
     def measured_hand(self) -> FloatArray: ...
 
@@ -62,10 +65,31 @@ class Slots:
         bits = self._own_bits(mask)
         self.robot.hand_target[bits] = np.asarray(q16)[bits]
 
+    def arm_course(self, rows: FloatArray) -> Course:
+        """A writer of the arm set-points ``rows[k]`` ((K, 6) rad) of coasted periods; the
+        ownership is checked once, here (see :meth:`dial.scheduler.types.Primitive.course`)."""
+        self._own("arm")
+        robot = self.robot
+
+        def write(k: int) -> None:
+            robot.arm_target = rows[k]  # never written in place: a row of rows will do
+
+        return write
+
+    def joints_course(self, mask: int, rows: FloatArray) -> Course:
+        """A writer of the masked hand joints' set-points from ``rows[k]`` ((K, 16) rad)."""
+        bits = np.array(self._own_bits(mask), dtype=np.intp)
+        masked, robot = rows[:, bits], self.robot
+
+        def write(k: int) -> None:
+            robot.hand_target[bits] = masked[k]
+
+        return write
+
     def limp(self, mask: int, on: bool) -> None:
         """Make the masked joints back-drivable, or stiff again where they went."""
         bits = self._own_bits(mask)
-        self.robot.limp[bits] = on
+        self.robot.set_limp(bits, on)
         if not on:  # the joints hold where they went
             self.robot.hand_target[bits] = self.robot.measured_hand()[bits]
 

@@ -289,7 +289,7 @@ class Saved:
         robot.steps = int(r["steps"])
         robot.arm_target = _floats(r["arm_target"], 6, "arm_target")
         robot.hand_target = _floats(r["hand_target"], 16, "hand_target")
-        robot.limp[:] = _flags(r["limp"], robot.limp.size, "limp")
+        robot.set_limp(slice(None), _flags(r["limp"], robot.limp.size, "limp"))
         robot.safety.saturated_since[:] = _floats(r["saturated_since"], 32, "saturated_since")
         logged = robot.safety.saturation_logged
         logged[:] = _flags(r["saturation_logged"], logged.size, "saturation_logged")

@@ -10,18 +10,21 @@ otherwise solve one waypoint per control period).
 
 from __future__ import annotations
 
+import bisect
 import math
 from abc import abstractmethod
+from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
 
+from dial.backend.ik import recall, remember
 from dial.backend.snapshot import FloatArray, Snapshot
-from dial.geometry import Slerp, rpy_matrix, smooth
+from dial.geometry import Slerp, rpy_matrix, smooth, smooth_array
 from dial.primitives.context import Context, RobotPrimitive
 from dial.scene.valii import Appro, Depart, Drive, Move, Statement
-from dial.scheduler.types import DONE, Ended, Now, Outcome, RunInfo
+from dial.scheduler.types import DONE, Course, Ended, Now, Outcome, RunInfo
 
 JOINT_SPEED = 1.0  # rad/s: nominal, only to share a run's time among its segments
 LINEAR_SPEED = 0.25  # m/s
@@ -66,6 +69,16 @@ class Segment:
         steps: FloatArray = self.waypoints[1:] - self.waypoints[:-1]
         return steps
 
+    def at_array(self, u: FloatArray) -> FloatArray:
+        """(K, 6): :meth:`at` of each fraction, bit for bit."""
+        last = len(self.waypoints) - 1
+        x = np.minimum(1.0, np.maximum(0.0, u)) * last
+        k = np.minimum(x.astype(np.intp), last - 1)
+        a, b = self.waypoints[k], self.waypoints[k + 1]
+        out: FloatArray = a + (b - a) * (x - k)[:, None]
+        out[x >= last] = self.q1
+        return out
+
 
 class Planner:
     """Turns statements into segments, from a start configuration."""
@@ -81,6 +94,20 @@ class Planner:
         self.q = q1
 
     def line_to(self, p1: FloatArray, r1: FloatArray, what: str) -> None:
+        """A straight tool line to the pose, as IK waypoints. A line depends only on its
+        start and goal (the solves are deterministic), so a line planned before in this
+        process (a sweep's trials, a loop's passes) is taken whole from the IK's memo."""
+        # Under the IK's own name: the preview's IK (dial.preview.ik) answers to rounding only.
+        key, known = recall(f"{self.ctx.arm_ik.MEMO}-line", self.q, p1, r1)
+        if not isinstance(known, Segment):
+            self._line(p1, r1, what)
+            known = self.segments.pop()
+            known.waypoints.flags.writeable = False  # shared by every run that plans it
+            remember(key, known)
+        self.segments.append(known)
+        self.q = known.q1
+
+    def _line(self, p1: FloatArray, r1: FloatArray, what: str) -> None:
         ik = self.ctx.arm_ik
         p0, r0 = ik.fk(self.q)
         q1 = ik.solve(p1, r1, self.q, what)
@@ -154,6 +181,10 @@ class ArmMotion(RobotPrimitive):
         for s in self.segments:
             acc += s.cost / total if total > 0 else 1.0 / len(self.segments)
             self.bounds.append(acc)
+        self._ends = np.array(self.bounds)  # for course: each segment's end and start
+        self._starts = np.concatenate(([0.0], self._ends[:-1]))
+        self._table: FloatArray | None = None  # course's set-points, made at its first call
+        self._progress: list[float] = []
         self.q = snapshot.arm_target.copy()
 
     def step(self, snapshot: Snapshot, now: Now) -> Ended | None:
@@ -168,8 +199,49 @@ class ArmMotion(RobotPrimitive):
         self.slots.arm(self.q)
         return None
 
+    open_loop = True
+
+    def course(self, progress: Sequence[float]) -> Course:
+        """The set-points :meth:`step` would write at each progress. The runner's progress
+        at the k-th period of the run's tick time is min(1, k / span) (1 for a one-tick run):
+        the set-points of all of them are computed once, as one array, and a course is a
+        slice of it (checked: any other progress is computed as it comes)."""
+        if not self.segments:
+            return _unmoved
+        if self._table is None:
+            info = self.info
+            n = info.periods_per_tick
+            span = (info.run.exec_end - info.run.start + 1) * n
+            self._progress = (
+                [1.0] * span if span == n else [min(1.0, k / span) for k in range(1, span + 1)]
+            )
+            self._table = self._rows(np.array(self._progress))
+            self._table.flags.writeable = False
+        i, wanted = bisect.bisect_left(self._progress, progress[0]), list(progress)
+        if self._progress[i : i + len(wanted)] == wanted:
+            return self.slots.arm_course(self._table[i : i + len(wanted)])
+        return self.slots.arm_course(self._rows(np.array(wanted)))
+
+    def _rows(self, p: FloatArray) -> FloatArray:
+        """(len(p), 6): :meth:`step`'s set-points at each progress in ``p``, bit for bit."""
+        if len(self.segments) == 1:
+            return self.segments[0].at_array(smooth_array(p / max(self.bounds[0], 1e-12)))
+        ends = self._ends
+        # The first segment whose end (+1e-12) the progress has not passed, as step's loop.
+        which = np.minimum(np.searchsorted(ends + 1e-12, p, side="left"), len(ends) - 1)
+        starts = self._starts[which]
+        u = smooth_array((p - starts) / np.maximum(ends[which] - starts, 1e-12))
+        rows = np.empty((len(p), 6))
+        for j in range(int(which[0]), int(which[-1]) + 1):  # progress only grows
+            rows[which == j] = self.segments[j].at_array(u[which == j])
+        return rows
+
     def finish(self, snapshot: Snapshot) -> Ended:
         return Ended(Outcome.DONE, warnings=self.warnings) if self.warnings else DONE
+
+
+def _unmoved(k: int) -> None:
+    """The course of a run with nothing to move: it writes nothing."""
 
 
 class PumaCommand(ArmMotion):

@@ -2,16 +2,22 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 
 from dial.backend.snapshot import FloatArray, Snapshot
-from dial.geometry import smooth
+from dial.geometry import smooth, smooth_array
 from dial.primitives.context import Context, RobotPrimitive, done, missed
-from dial.scheduler.types import Ended, Now, RunInfo
+from dial.scheduler.types import Course, Ended, Now, RunInfo
 
 
 def _bits(mask: int) -> list[int]:
     return [k for k in range(16) if mask >> k & 1]
+
+
+def _nothing(k: int) -> None:
+    """The course of a run that writes no set-points."""
 
 
 class HandPose(RobotPrimitive):
@@ -29,6 +35,12 @@ class HandPose(RobotPrimitive):
     def step(self, snapshot: Snapshot, now: Now) -> Ended | None:
         self.slots.joints(self.mask, self.q0 + (self.q1 - self.q0) * smooth(now.progress))
         return None
+
+    open_loop = True
+
+    def course(self, progress: Sequence[float]) -> Course:
+        s = smooth_array(np.asarray(progress, dtype=np.float64))
+        return self.slots.joints_course(self.mask, self.q0 + (self.q1 - self.q0) * s[:, None])
 
 
 class GraspForce(RobotPrimitive):
@@ -56,24 +68,28 @@ class GraspForce(RobotPrimitive):
             for f in self.fingers
         }
         self.stopped: dict[int, float] = {}
+        self.jbits, self.tbits = _bits(self.jmask), _bits(self.tmask)
+        self.monitored = {k // 4 for k in self.tbits} or set(self.fingers)
 
     def step(self, snapshot: Snapshot, now: Now) -> Ended | None:
-        diff = snapshot.differentials
+        diff = snapshot.differentials.tolist()
         for f in self.fingers:
             if f not in self.stopped and max(diff[k] for k in self.watched[f]) >= self.force:
                 self.stopped[f] = now.sim_time
-        closing = [k for k in _bits(self.jmask) if k // 4 not in self.stopped]
+        closing = [k for k in self.jbits if k // 4 not in self.stopped]
         self.target[closing] = np.minimum(self.target[closing] + self.rate, self.upper[closing])
         self.slots.joints(self.jmask, self.target)
-        monitored = {k // 4 for k in _bits(self.tmask)} or set(self.fingers)
-        forces = {f"j{k}": float(diff[k]) for k in _bits(self.tmask)}
-        if monitored <= set(self.stopped):
-            return done(forces=forces)
-        if all(self.target[k] >= self.upper[k] for k in closing) and not monitored & set(
-            self.stopped
+        if self.monitored <= self.stopped.keys():
+            return done(forces=self._forces(diff))
+        if all(self.target[k] >= self.upper[k] for k in closing) and not (
+            self.monitored & self.stopped.keys()
         ):
-            return missed("the fingers closed fully without reaching the force", forces=forces)
+            message = "the fingers closed fully without reaching the force"
+            return missed(message, forces=self._forces(diff))
         return None
+
+    def _forces(self, diff: list[float]) -> dict[str, float]:
+        return {f"j{k}": diff[k] for k in self.tbits}
 
 
 class Limp(RobotPrimitive):
@@ -90,6 +106,11 @@ class Limp(RobotPrimitive):
 
     def step(self, snapshot: Snapshot, now: Now) -> Ended | None:
         return None
+
+    open_loop = True  # the limp joints follow their measured angle in the driver
+
+    def course(self, progress: Sequence[float]) -> Course:
+        return _nothing
 
     def finish(self, snapshot: Snapshot) -> Ended:
         self.slots.limp(self.mask, False)

@@ -1,49 +1,37 @@
-"""The tick clock and the table of active runs: one block at a time (DESIGN 2.5, 2.7).
+"""The tick clock: one block at a time, tick by tick (DESIGN 2.5, 2.7).
 
-Every control period the loop hands each active run the same immutable snapshot, in a
-fixed order (start tick, then line), lets the robot advance, logs what the robot reports,
-and stops the runs that ended, in the same order. Nothing here awaits per run: a run is
-a synchronous step object, so trio's task order cannot reach a result.
+A block's runs start in line order at their tick; every tick's control periods go through
+:class:`~dial.scheduler.periods.Periods`; a fixed-length run ends with its last executing
+tick, and an indeterminate one still going stretches it. A watched span arms its monitors
+in the robot; when one fires, the block is preempted and its ``@on`` reaction runs next.
 """
 
 from __future__ import annotations
 
 from collections import defaultdict
-from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Generic, NamedTuple, cast
-
-import trio
+from typing import NamedTuple, cast
 
 from dial.errors import DialError
 from dial.parser.script import Run, Script, TBlock, TOn, Watch
 from dial.scheduler.active import ActiveRun, RunPlan
-from dial.scheduler.position import Hooks, Resume
+from dial.scheduler.periods import ABORT_ON, Observe, Periods, Progress
 from dial.scheduler.records import Records
 from dial.scheduler.signals import StopRequest
 from dial.scheduler.types import (
     Ended,
     Fired,
-    Interrupted,
     Monitor,
-    Now,
     Outcome,
     Primitive,
     PrimitiveFactory,
-    Report,
     Robot,
-    RunAborted,
     RunInfo,
     S,
     Sensor,
 )
 
-ABORT_ON = frozenset({Outcome.TIMEOUT, Outcome.ERROR})
-OUTCOME_TEXT = {o: o.value for o in Outcome}  # a dict lookup is cheaper than Enum.value
-YIELD_EVERY = 64  # periods between trio checkpoints when not paced (other tasks, I/O)
-
-Progress = Callable[[int, float, list[str]], None]  # (tick, sim time, running events)
-Observe = Callable[[int, int], None]  # (periods so far, tick), after every period
+__all__ = ["Observe", "Preempted", "Progress", "TickLoop"]
 
 
 class _Plan(NamedTuple):
@@ -62,7 +50,7 @@ class Preempted:
     tick: int
 
 
-class TickLoop(Generic[S]):
+class TickLoop(Periods[S]):
     """Runs blocks against a robot: the tick clock, the active runs, monitors, preemption."""
 
     def __init__(
@@ -76,37 +64,10 @@ class TickLoop(Generic[S]):
         progress: Progress | None = None,
         pace: float | None = None,
     ) -> None:
-        self.robot, self.factory, self.n = robot, factory, n
-        self.period = robot.period
-        self.records, self.stop = records, stop
-        self.observe, self.progress, self.pace = observe, progress, pace
-        self.periods = 0  # control periods simulated so far
-        self.clock = 0  # tick time, in periods: stands still while a tick is stretched
-        self.tick = 0  # absolute ticks started so far
-        self.active: list[ActiveRun[S]] = []  # this block's unstopped runs, in step order
-        self.latest: dict[tuple[str, str], Outcome] = {}  # (script, event) -> last outcome
-        self.counts: dict[str, int] = defaultdict(int)
-        self.abort: RunAborted | None = None
-        self._ending = False  # some run ended this period: stop it after the period
+        super().__init__(robot, n, records, stop, observe, pace)
+        self.factory, self.progress = factory, progress
         self._plans: dict[int, _Plan] = {}
         self._runs: dict[tuple[str, int], RunPlan] = {}
-        self.hooks: Hooks | None = None
-        self._snap: S | None = None
-        self.t0 = 0.0  # trio time at the first period, for pacing
-
-    @property
-    def sim_time(self) -> float:
-        return self.periods * self.period
-
-    def progress_of(self, a: ActiveRun[S]) -> float:
-        """A run's progress in tick time now (0 to 1)."""
-        return 1.0 if a.span == self.n else min(1.0, (self.clock - a.start_clock) / a.span)
-
-    def restore(self, resume: Resume) -> None:
-        """Take up the clocks, outcomes and counts of a run saved at a block boundary."""
-        self.periods, self.clock, self.tick = resume.periods, resume.clock, resume.tick
-        self.latest.update(resume.latest)
-        self.counts.update(resume.counts)
 
     # -- one block ------------------------------------------------------------------------------
     async def block(self, script: Script, block: TBlock) -> Preempted | None:
@@ -125,10 +86,11 @@ class TickLoop(Generic[S]):
                 for run in plan.starts.get(k, ()):
                     self._start(script, run)
                 self._raise_pending()
-                stretch = 0
-                for _ in range(self.n):
-                    self.clock += 1
-                    if fired := await self._period(stretched=False):
+                stretch, left = 0, self.n
+                while left:
+                    fired, done = await self._periods(left)
+                    left -= done
+                    if fired:
                         return await self._preempted(script, block, fired, monitors, k, t0, stretch)
                 # An indeterminate run still going at the end of its last tick stretches it.
                 stretching = self._finish(k)
@@ -175,13 +137,6 @@ class TickLoop(Generic[S]):
             plan = self._runs[key] = RunPlan.of(info)
         return plan
 
-    def _snapshot(self) -> S:
-        """The robot's snapshot, taken once per state: starts, senses and the next period's
-        steps share it until the robot advances or a run's finish or stop writes a slot."""
-        if self._snap is None:
-            self._snap = self.robot.snapshot()
-        return self._snap
-
     def _start(self, script: Script, run: Run) -> None:
         """Start a run in line order; a sensing run happens at once."""
         plan = self._run_plan(script, run)
@@ -214,59 +169,6 @@ class TickLoop(Generic[S]):
         if ended.outcome in ABORT_ON:
             raise self._aborted(script, run, ended)
 
-    # -- control periods ----------------------------------------------------------------------
-    async def _period(self, stretched: bool) -> tuple[Fired, ...]:
-        fired = self._step(stretched)
-        if self.pace is not None:  # --realtime: never changes what happens, only when
-            await trio.sleep_until(self.t0 + self.periods * self.period * self.pace)
-        elif self.periods % YIELD_EVERY == 0:
-            await trio.lowlevel.checkpoint()
-        if self.hooks is not None and self.hooks.each_period:
-            await self.hooks.after_period(self.periods)
-            self._raise_pending()
-        return fired
-
-    def _step(self, stretched: bool) -> tuple[Fired, ...]:
-        """Step every active run in order, advance the robot, stop the runs that ended."""
-        snapshot = self._snapshot()
-        periods = self.periods + 1
-        t_end = periods * self.period
-        tick, clock, n = self.tick, self.clock, self.n
-        for a in self.active:
-            if a.ended is not None:
-                continue
-            elapsed = (periods - a.start_period) * self.period
-            # A one-tick run is a GOTO MOVE: the set-point jumps at once.
-            progress = 1.0 if a.span == n else min(1.0, (clock - a.start_clock) / a.span)
-            try:
-                ended = a.prim.step(snapshot, Now(t_end, tick, progress, elapsed, stretched))
-            except DialError as e:
-                ended = Ended(Outcome.ERROR, str(e))
-            if ended is None and a.timeout is not None and elapsed >= a.timeout - 1e-9:
-                ended = Ended(Outcome.TIMEOUT, f"no result after {a.timeout:g} s")
-            if ended is not None:
-                self._end(a, ended, t_end)
-        report = self.robot.advance()
-        self._snap = None
-        self.periods = periods
-        fired = () if report is None else self._report(report)
-        if self.observe is not None:
-            self.observe(periods, tick)
-        self._raise_pending()
-        return fired
-
-    def _report(self, report: Report) -> tuple[Fired, ...]:
-        for happening in report.happenings:
-            self.records.happening(happening, self.tick)
-        if report.fault is not None and self.abort is None:
-            running = ", ".join(a.info.event.name for a in self.active if a.ended is None)
-            self.abort = RunAborted(
-                f"safety monitor: {report.fault} (running: {running or 'no event'})",
-                None,
-                self.tick,
-            )
-        return report.fired
-
     def _finish(self, k: int) -> bool:
         """End the fixed-length runs whose last executing tick ``k`` was; whether an
         indeterminate one is still going, so that the tick stretches."""
@@ -284,54 +186,6 @@ class TickLoop(Generic[S]):
             self._end(a, ended, self.sim_time)
         self._raise_pending()
         return stretching
-
-    # -- ending runs ----------------------------------------------------------------------------
-    def _end(self, a: ActiveRun[S], ended: Ended, t: float) -> None:
-        a.ended = ended
-        self._ending = True
-        self._record_end(a.script, a.info.run, ended, t)
-        if ended.outcome in ABORT_ON and self.abort is None:
-            self.abort = self._aborted(a.script, a.info.run, ended)
-
-    def _record_end(self, script: Script, run: Run, ended: Ended, t: float) -> None:
-        self.latest[(script.path, run.event)] = ended.outcome
-        self.counts[OUTCOME_TEXT[ended.outcome]] += 1
-        self.records.end(script.path, run, ended, self.tick, t)
-
-    def _raise_pending(self) -> None:
-        """Stop the runs that ended; then stop the script if a signal or an abort says so."""
-        if self._ending:
-            self.stop_runs(ended_only=True)
-        if self.stop.signal is not None:
-            raise Interrupted(self.stop.signal)
-        if self.abort is not None:
-            raise self.abort
-
-    def stop_runs(self, ended_only: bool = False) -> None:
-        """Call ``stop`` of the (ended) active runs, in order: every one, even if one raises."""
-        self._ending = False
-        self._snap = None  # a stop (or the finish before it) may have written a slot
-        keep = [a for a in self.active if ended_only and a.ended is None]
-        stopping = [a for a in self.active if not (ended_only and a.ended is None)]
-        self.active = keep
-        error: BaseException | None = None
-        for a in stopping:
-            try:
-                a.prim.stop()
-            except BaseException as e:  # the others still stop; the first error goes on
-                error = error or e
-        if error is not None:
-            raise error
-
-    def _aborted(self, script: Script, run: Run, ended: Ended) -> RunAborted:
-        line = script.events[run.event].definition.line
-        why = f": {ended.message}" if ended.message else ""
-        return RunAborted(
-            f"event '{run.event}' (defined on line {line} of {script.path}) ended "
-            f"{ended.outcome.value} at tick {self.tick}{why}",
-            run.event,
-            self.tick,
-        )
 
     # -- monitors and preemption (DESIGN 2.7) -------------------------------------------------
     def _arm(

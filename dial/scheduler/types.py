@@ -8,13 +8,14 @@ zero-length sensing) per run through a :data:`PrimitiveFactory`.
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from enum import StrEnum
 from typing import Generic, NamedTuple, Protocol, TypeVar
 
 from dial.errors import DialError
 from dial.parser.script import EventDef, Run
+from dial.scheduler.signals import StopRequest
 
 S = TypeVar("S")
 S_co = TypeVar("S_co", covariant=True)
@@ -65,6 +66,9 @@ class Now(NamedTuple):
     stretched: bool
 
 
+Course = Callable[[int], None]  # writes the k-th coasted period's set-points (Primitive.course)
+
+
 class Primitive(ABC, Generic[S_contra]):
     """One run of an instruction, stepped synchronously by the runner.
 
@@ -85,6 +89,16 @@ class Primitive(ABC, Generic[S_contra]):
     def finish(self, snapshot: S_contra) -> Ended:
         """End a fixed-length run at the end of its last executing tick."""
         return DONE
+
+    #: An open-loop run's steps read nothing of the snapshot and never end it: its set-points
+    #: are a function of its progress alone, so the runner may take them in one go (coast).
+    open_loop: bool = False
+
+    def course(self, progress: Sequence[float]) -> Course:
+        """An open-loop run's writer of the set-points that :meth:`step` would write in the
+        coming periods, at these progress values (one per period, in order): calling it with
+        ``k`` writes the ``k``-th period's and leaves the run as if stepped through it."""
+        raise NotImplementedError(f"{type(self).__name__} is not open-loop")
 
     def stop(self) -> None:
         """Clean up; the effectors keep holding their last command."""
@@ -169,6 +183,14 @@ class Robot(Protocol[S_co]):
         """Apply the command slots and simulate one control period."""
         ...
 
+    def coast(
+        self, writes: Sequence[Course], periods: int, stop: StopRequest
+    ) -> tuple[int, Report | None]:
+        """``advance`` up to ``periods`` times, each after ``write(k)`` of every course for
+        the k-th period; return after a period that reports anything, or once ``stop`` has a
+        signal: (periods taken, that report or None)."""
+        ...
+
     def hold_all(self) -> None:
         """Freeze every effector where it is measured now (abort, interrupt)."""
         ...
@@ -184,6 +206,20 @@ class Robot(Protocol[S_co]):
     def disarm(self, key: int) -> None:
         """Stop testing a monitor."""
         ...
+
+
+def advance_through(
+    robot: Robot[object], writes: Sequence[Course], periods: int, stop: StopRequest
+) -> tuple[int, Report | None]:
+    """:meth:`Robot.coast` done with :meth:`Robot.advance`, one period after another: what a
+    robot with no faster way of its own does."""
+    for k in range(periods):
+        for write in writes:
+            write(k)
+        report = robot.advance()
+        if report is not None or stop.signal is not None:
+            return k + 1, report
+    return periods, None
 
 
 class RunAborted(DialError):

@@ -23,7 +23,9 @@ from dial.parser.check import check_text
 from dial.parser.script import Script
 from dial.scheduler.log import EventLog, Record
 from dial.scheduler.runner import Runner, RunSummary
+from dial.scheduler.signals import StopRequest
 from dial.scheduler.types import (
+    Course,
     Ended,
     Fired,
     Monitor,
@@ -33,6 +35,7 @@ from dial.scheduler.types import (
     Report,
     RunInfo,
     Sensor,
+    advance_through,
 )
 
 
@@ -66,6 +69,7 @@ class FakeRobot:
         self.armed: list[tuple[int, str, bool]] = []  # (period, event, negated), as armed
         self._keys = itertools.count(1)
         self.stops: list[str] = []  # events whose run was stopped, in order
+        self.coasts: list[int] = []  # the first period of each coast (Periods._coast)
 
     @property
     def period(self) -> float:
@@ -86,6 +90,12 @@ class FakeRobot:
             if (periods in self.conditions.get(m.event.name, ())) != m.negated
         )
         return Report(fault, (), fired) if fault is not None or fired else None
+
+    def coast(
+        self, writes: Sequence[Course], periods: int, stop: StopRequest
+    ) -> tuple[int, Report | None]:
+        self.coasts.append(self.periods + 1)
+        return advance_through(self, writes, periods, stop)
 
     def hold_all(self) -> None:
         self.held = True
@@ -130,6 +140,15 @@ class _Motion(Primitive[FakeSnapshot]):
         for effector in self.effectors:
             self.commands[effector] = now.progress
         return None
+
+    open_loop = True
+
+    def course(self, progress: Sequence[float]) -> Course:
+        def write(k: int) -> None:
+            for effector in self.effectors:
+                self.commands[effector] = progress[k]
+
+        return write
 
     def stop(self) -> None:
         self.stops.append(self.name)
