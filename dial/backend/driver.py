@@ -22,6 +22,7 @@ from dial.backend.guards import Guard, Guards, Readings
 from dial.backend.locate import finger_bodies, link_point, tactile_point
 from dial.backend.model import HAND_JOINTS, IntArray, RobotIndex, hand_ctrl, tendon_differentials
 from dial.backend.safety import Safety
+from dial.backend.slots import ArmCourse, still
 from dial.backend.snapshot import FloatArray, Snapshot, Trip, frozen
 from dial.instructions.catalogue import contact_condition
 from dial.instructions.types import FINGERS
@@ -185,10 +186,18 @@ class MujocoRobot:
         if self.guards or self.threads or self.disturbances.due(self.steps, periods * n):
             return advance_through(self, writes, periods, stop)
         m, d, safety, happened = self.model, self.data, self.safety, self._happened
+        writes = [w for w in writes if w is not still]
+        # Only the arm moves: the hand's controls are written once, not every period.
+        arm_only = not self._limping and all(isinstance(w, ArmCourse) for w in writes)
+        ctrl, arm_ctrl = d.ctrl, self._arm_ctrl
+        self._apply()
         for k in range(periods):
             for write in writes:
                 write(k)
-            self._apply()
+            if arm_only:
+                ctrl[arm_ctrl] = self.arm_target
+            else:
+                self._apply()
             mujoco.mj_step(m, d, nstep=n)
             self.steps += n
             fault = safety.check(self.steps * self._dt, happened)

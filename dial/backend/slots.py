@@ -39,20 +39,41 @@ def _bits(mask: int) -> list[int]:
     return [k for k in range(16) if mask >> k & 1]
 
 
+class ArmCourse:
+    """A course that writes the arm's set-points and nothing else (the driver, knowing it,
+    leaves the hand's controls as they are while it coasts)."""
+
+    __slots__ = ("robot", "rows")
+
+    def __init__(self, robot: Commanded, rows: FloatArray) -> None:
+        self.robot, self.rows = robot, rows
+
+    def __call__(self, k: int) -> None:
+        self.robot.arm_target = self.rows[k]  # never written in place: a row of rows will do
+
+
+def still(k: int) -> None:
+    """The course of a run that writes no set-point (a limp run, an arm with nowhere to go)."""
+
+
 class Slots:
     """The command slots a run owns: writing another effector's raises :class:`EffectorError`."""
 
     def __init__(self, robot: Commanded, effectors: frozenset[str]) -> None:
         self.robot, self.effectors = robot, effectors
+        self._owned: dict[int, list[int]] = {}  # masks checked, and their bits
 
     def _own(self, effector: str) -> None:
         if effector not in self.effectors:
             raise EffectorError(f"run does not own the {effector}")
 
     def _own_bits(self, mask: int) -> list[int]:
-        bits = _bits(mask)
-        for f in {k // 4 for k in bits}:
-            self._own(FINGERS[f])
+        bits = self._owned.get(mask)
+        if bits is None:  # a grasp writes the same mask every period: check it once
+            bits = _bits(mask)
+            for f in {k // 4 for k in bits}:
+                self._own(FINGERS[f])
+            self._owned[mask] = bits
         return bits
 
     def arm(self, q: FloatArray) -> None:
@@ -65,16 +86,11 @@ class Slots:
         bits = self._own_bits(mask)
         self.robot.hand_target[bits] = np.asarray(q16)[bits]
 
-    def arm_course(self, rows: FloatArray) -> Course:
+    def arm_course(self, rows: FloatArray) -> ArmCourse:
         """A writer of the arm set-points ``rows[k]`` ((K, 6) rad) of coasted periods; the
         ownership is checked once, here (see :meth:`dial.scheduler.types.Primitive.course`)."""
         self._own("arm")
-        robot = self.robot
-
-        def write(k: int) -> None:
-            robot.arm_target = rows[k]  # never written in place: a row of rows will do
-
-        return write
+        return ArmCourse(self.robot, rows)
 
     def joints_course(self, mask: int, rows: FloatArray) -> Course:
         """A writer of the masked hand joints' set-points from ``rows[k]`` ((K, 16) rad)."""

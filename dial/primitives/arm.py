@@ -20,6 +20,7 @@ from functools import cached_property
 import numpy as np
 
 from dial.backend.ik import recall, remember
+from dial.backend.slots import still
 from dial.backend.snapshot import FloatArray, Snapshot
 from dial.geometry import Slerp, rpy_matrix, smooth, smooth_array
 from dial.primitives.context import Context, RobotPrimitive
@@ -207,7 +208,7 @@ class ArmMotion(RobotPrimitive):
         the set-points of all of them are computed once, as one array, and a course is a
         slice of it (checked: any other progress is computed as it comes)."""
         if not self.segments:
-            return _unmoved
+            return still
         if self._table is None:
             info = self.info
             n = info.periods_per_tick
@@ -238,10 +239,6 @@ class ArmMotion(RobotPrimitive):
 
     def finish(self, snapshot: Snapshot) -> Ended:
         return Ended(Outcome.DONE, warnings=self.warnings) if self.warnings else DONE
-
-
-def _unmoved(k: int) -> None:
-    """The course of a run with nothing to move: it writes nothing."""
 
 
 class PumaCommand(ArmMotion):

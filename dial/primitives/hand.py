@@ -6,6 +6,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from dial.backend.slots import still
 from dial.backend.snapshot import FloatArray, Snapshot
 from dial.geometry import smooth, smooth_array
 from dial.primitives.context import Context, RobotPrimitive, done, missed
@@ -14,10 +15,6 @@ from dial.scheduler.types import Course, Ended, Now, RunInfo
 
 def _bits(mask: int) -> list[int]:
     return [k for k in range(16) if mask >> k & 1]
-
-
-def _nothing(k: int) -> None:
-    """The course of a run that writes no set-points."""
 
 
 class HandPose(RobotPrimitive):
@@ -110,7 +107,7 @@ class Limp(RobotPrimitive):
     open_loop = True  # the limp joints follow their measured angle in the driver
 
     def course(self, progress: Sequence[float]) -> Course:
-        return _nothing
+        return still
 
     def finish(self, snapshot: Snapshot) -> Ended:
         self.slots.limp(self.mask, False)
