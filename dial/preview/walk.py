@@ -33,7 +33,7 @@ from dial.preview.report import Counts, Problems
 from dial.preview.scene import Hit, Scene, State, finger_group
 from dial.primitives import CLASSES
 from dial.primitives.arm import ArmMotion
-from dial.scheduler.types import Now, Outcome, Primitive, RunInfo
+from dial.scheduler.types import Course, Now, Outcome, Primitive, RunInfo
 
 ARM_STEP = np.radians(0.25)  # rad of any arm joint between two checks of a moving pose
 HAND_STEP = np.radians(1.0)  # rad of any hand joint
@@ -195,12 +195,12 @@ class Walk:
             self.clock += self.n
             return None
         snapshot = self.scene.robot.snapshot()
-        for _ in range(self.n):
+        writes = [self.course(a, k, snapshot) for a in moving]
+        for i in range(self.n):
             self.clock += 1
-            for a in moving:
-                done = (self.clock - a.start_clock) / a.span  # a one-tick run: a GOTO
-                a.progress = 1.0 if a.span == self.n else min(1.0, done)
-                a.prim.step(snapshot, Now(0.0, k, a.progress, 0.0, False))
+            for a, write in zip(moving, writes, strict=True):
+                a.progress = self.progress(a, self.clock)
+                write(i)
             if armed:
                 self.look()
                 fired = self.fires(script, block, armed)
@@ -209,6 +209,23 @@ class Walk:
             else:
                 self.glance()
         return None
+
+    def progress(self, a: Active, clock: int) -> float:
+        """A run's progress in tick time at the end of period ``clock``, as the runner has it
+        (a one-tick run: a GOTO)."""
+        return 1.0 if a.span == self.n else min(1.0, (clock - a.start_clock) / a.span)
+
+    def course(self, a: Active, k: int, snapshot: Snapshot) -> Course:
+        """A writer of the run's set-points in the ``i``-th period of tick ``k``: an open-loop
+        run's course (what its step would write, bit for bit, worked out for the whole tick
+        at once), else its step."""
+        if a.prim.open_loop:
+            return a.prim.course([self.progress(a, self.clock + i) for i in range(1, self.n + 1)])
+
+        def step(i: int) -> None:
+            a.prim.step(snapshot, Now(0.0, k, a.progress, 0.0, False))
+
+        return step
 
     def fires(self, script: Script, block: TBlock, armed: list[Watch]) -> TOn | None:
         """The first ``@on`` (in file order) whose watched contact condition holds now."""
