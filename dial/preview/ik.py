@@ -55,13 +55,13 @@ class LeanArmIK(ArmIK):
         self._velocity = np.zeros(self.model.nv)
         self._damping = DAMPING * np.eye(len(qpos))  # mink's, as its task adds none of its own
         assert task.lm_damping == 0.0, "the frame task's own damping is not modelled here"
-        self._tools: dict[bytes, tuple[FloatArray, FloatArray]] = {}  # fk where tracks ended
+        self._tools: dict[bytes, FloatArray] = {}  # fk (position, rotation) where tracks ended
 
     def fk(self, arm_q: FloatArray) -> tuple[FloatArray, FloatArray]:
         known = self._tools.get(np.asarray(arm_q, dtype=np.float64).tobytes())
         if known is None:
             return super().fk(arm_q)
-        return known[0].copy(), known[1].copy()
+        return known[:3].copy(), known[3:].reshape(3, 3).copy()
 
     def _set(self, arm_q: FloatArray) -> None:
         data = self.config.data
@@ -75,7 +75,7 @@ class LeanArmIK(ArmIK):
         mujoco.mju_mat2Quat(target[:4], np.ascontiguousarray(rot, dtype=np.float64).ravel())
         target[4:] = pos
         task.transform_target_to_world = mink.SE3(wxyz_xyz=target)  # set_target, less a copy
-        start = config.data.qpos.copy()
+        start = config.data.qpos.copy() if iterations > LEAN_ITERATIONS else None
         perr = rerr = np.inf
         for _ in range(min(iterations, LEAN_ITERATIONS)):
             err = task.compute_error(config)
@@ -97,7 +97,7 @@ class LeanArmIK(ArmIK):
         if len(self._tools) > 10_000:
             self._tools.clear()
         data, site = self.config.data, self.index.tool_site
-        pose = (data.site_xpos[site].copy(), data.site_xmat[site].reshape(3, 3).copy())
+        pose = np.concatenate((data.site_xpos[site], data.site_xmat[site]))
         self._tools[data.qpos[self._qpos].tobytes()] = pose
 
     def _step(self, err: FloatArray, jac: FloatArray) -> FloatArray:
