@@ -63,6 +63,16 @@ class LeanArmIK(ArmIK):
             return super().fk(arm_q)
         return known[:3].copy(), known[3:].reshape(3, 3).copy()
 
+    def track(
+        self, pos: FloatArray, rot: FloatArray, arm_q: FloatArray, iterations: int = 2
+    ) -> FloatArray:
+        """:meth:`ArmIK.track` without the memo: the planner keeps a line whole, and no
+        waypoint is asked for twice otherwise (the memo's bookkeeping was all cost)."""
+        self._set(arm_q)
+        self._iterate(pos, rot, iterations)
+        q: FloatArray = self.config.data.qpos[self._qpos].copy()
+        return q
+
     def _set(self, arm_q: FloatArray) -> None:
         data = self.config.data
         if data.qpos[self._qpos].tobytes() != np.asarray(arm_q, dtype=np.float64).tobytes():

@@ -4,14 +4,17 @@ from __future__ import annotations
 
 import itertools
 import re
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
 from dial.backend.ik import ArmIK, IKError, forget_solutions
 from dial.backend.model import ARM_HOME, ROBOT_DIR, load_model, load_untextured
+from dial.backend.snapshot import FloatArray
 from dial.geometry import Slerp, rpy_matrix
 from dial.preview.ik import LeanArmIK, box_qp
+from dial.primitives.arm import Planner
 
 
 @pytest.fixture(scope="module")
@@ -72,11 +75,18 @@ def test_the_runs_memo_never_serves_the_previews_answers(
     run, lean = solvers
     home = np.array(ARM_HOME)
     pos, rot = run.fk(home + 0.05)
+
+    def line(ik: ArmIK) -> FloatArray:
+        planner = Planner(SimpleNamespace(arm_ik=ik), home)  # type: ignore[arg-type]
+        planner.line_to(pos, rot, "a line")
+        return planner.segments[-1].waypoints
+
     forget_solutions()
-    fresh = run.track(pos, rot, home)
+    fresh = run.solve(pos, rot, home, "x"), line(run)
     forget_solutions()
-    lean.track(pos, rot, home)
-    assert run.track(pos, rot, home).tobytes() == fresh.tobytes()
+    lean.solve(pos, rot, home, "x"), line(lean)  # what a preview leaves in the memo
+    assert run.solve(pos, rot, home, "x").tobytes() == fresh[0].tobytes()
+    assert line(run).tobytes() == fresh[1].tobytes()
 
 
 def test_box_qp_satisfies_the_optimality_conditions() -> None:
