@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import copy
 import math
+from typing import Any
 
 import mink
 import mujoco
@@ -182,17 +183,11 @@ class FingerIKOnDemand(FingerIK):
             model, self._pending = self._pending, None
             super().__init__(copy.copy(model))
 
-    def tip(self, arm_q: FloatArray, hand_q: FloatArray, finger: int) -> FloatArray:
+    # The two ways in (their arguments as FingerIK's, which callers are checked against).
+    def tip(self, *args: Any, **kwargs: Any) -> FloatArray:
         self._ready()
-        return super().tip(arm_q, hand_q, finger)
+        return super().tip(*args, **kwargs)
 
-    def track(
-        self,
-        finger: int,
-        tip: FloatArray,
-        arm_q: FloatArray,
-        hand_q: FloatArray,
-        iterations: int = 2,
-    ) -> FloatArray:
+    def track(self, *args: Any, **kwargs: Any) -> FloatArray:
         self._ready()
-        return super().track(finger, tip, arm_q, hand_q, iterations)
+        return super().track(*args, **kwargs)
