@@ -4,16 +4,19 @@ from __future__ import annotations
 
 import itertools
 import re
+from pathlib import Path
 from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
-from dial.backend.ik import ArmIK, IKError, forget_solutions
+from dial.api import load
+from dial.backend.ik import ArmIK, FingerIK, IKError, forget_solutions
 from dial.backend.model import ARM_HOME, ROBOT_DIR, load_model, load_untextured
 from dial.backend.snapshot import FloatArray
 from dial.geometry import Slerp, rpy_matrix
-from dial.preview.ik import LeanArmIK, box_qp
+from dial.preview import preview
+from dial.preview.ik import FingerIKOnDemand, LeanArmIK, box_qp
 from dial.primitives.arm import Planner
 
 
@@ -118,3 +121,24 @@ def test_a_scene_compiled_without_textures_has_the_same_geometry() -> None:
         assert np.array_equal(getattr(full, field), getattr(bare, field)), field
     for field in ("geom_type", "geom_contype", "geom_conaffinity", "jnt_range", "qpos0"):
         assert np.array_equal(getattr(full, field), getattr(bare, field)), field
+
+
+def test_the_fingers_ik_set_up_on_first_use_answers_as_the_runs() -> None:
+    run, later = FingerIK(), FingerIKOnDemand(load_model())
+    arm, hand = np.array(ARM_HOME), np.zeros(16)
+    tip = run.tip(arm, hand, 0)
+    assert later.tip(arm, hand, 0).tobytes() == tip.tobytes()
+    goal = tip + np.array([0.0, 0.0, 0.005])
+    forget_solutions()
+    expected = run.track(0, goal, arm, hand)
+    forget_solutions()
+    assert later.track(0, goal, arm, hand).tobytes() == expected.tobytes()
+    assert np.abs(expected - hand).max() > 0.0  # the finger moved
+
+
+def test_a_finger_move_is_previewed(tmp_path: Path) -> None:
+    script = tmp_path / "tap.dial"
+    script.write_text("@scene surface\n% tap finger_move finger=index 5mm 0 0\n\ntap #==\n")
+    result = preview(load(script))
+    # ok: the fingertip ended within 3 mm of its goal, 5 mm away (the fingers' IK moved it)
+    assert result.ok and result.counts.hand == 1, result.problems
