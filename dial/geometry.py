@@ -79,19 +79,37 @@ def smooth_array(u: FloatArray) -> FloatArray:
 
 def slerp(r0: FloatArray, r1: FloatArray, u: float) -> FloatArray:
     """Rotation between ``r0`` and ``r1`` (u in [0, 1]) about their relative axis."""
-    rel = r0.T @ r1
-    angle = float(np.arccos(np.clip((np.trace(rel) - 1.0) / 2.0, -1.0, 1.0)))
-    if angle < 1e-9:
-        return r0.copy()
-    axis = np.array([rel[2, 1] - rel[1, 2], rel[0, 2] - rel[2, 0], rel[1, 0] - rel[0, 1]])
-    norm = np.linalg.norm(axis)
-    # A half turn has no antisymmetric part: its axis is the top eigenvector of rel + rel^T.
-    axis = np.linalg.eigh(rel + rel.T)[1][:, -1] if norm < 1e-9 else axis / norm
-    k = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
-    a = angle * u
-    step = np.eye(3) + np.sin(a) * k + (1.0 - np.cos(a)) * (k @ k)
-    out: FloatArray = r0 @ step
-    return out
+    return Slerp(r0, r1)(u)
+
+
+_EYE = np.eye(3)
+_EYE.flags.writeable = False
+
+
+class Slerp:
+    """Rotations between ``r0`` and ``r1`` about their relative axis, the axis found once."""
+
+    def __init__(self, r0: FloatArray, r1: FloatArray) -> None:
+        self.r0 = r0
+        rel = r0.T @ r1
+        self.angle = float(np.arccos(np.clip((np.trace(rel) - 1.0) / 2.0, -1.0, 1.0)))
+        if self.angle < 1e-9:
+            return
+        axis = np.array([rel[2, 1] - rel[1, 2], rel[0, 2] - rel[2, 0], rel[1, 0] - rel[0, 1]])
+        norm = np.linalg.norm(axis)
+        # A half turn has no antisymmetric part: its axis is the top eigenvector of rel + rel^T.
+        axis = np.linalg.eigh(rel + rel.T)[1][:, -1] if norm < 1e-9 else axis / norm
+        self.k = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+        self.kk = self.k @ self.k
+
+    def __call__(self, u: float) -> FloatArray:
+        """The rotation at fraction ``u`` in [0, 1]."""
+        if self.angle < 1e-9:
+            return self.r0.copy()
+        a = self.angle * u
+        step = _EYE + np.sin(a) * self.k + (1.0 - np.cos(a)) * self.kk
+        out: FloatArray = self.r0 @ step
+        return out
 
 
 def location_pose(world: World, believed: Mapping[str, Pose], name: str) -> Pose:

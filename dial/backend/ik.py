@@ -21,6 +21,8 @@ SOLVER = "daqp"
 DT = 0.01  # s: the differential step of one solve
 POS_TOL = 5e-4  # m
 ROT_TOL = 2e-3  # rad
+SOLVE_ITERATIONS = 200  # per start of ArmIK.solve
+DAMPING = 1e-3  # mink's Levenberg-Marquardt damping of every step
 
 
 class IKError(DialError):
@@ -86,8 +88,9 @@ def forget_solutions() -> None:
 
 
 class _Base:
-    def __init__(self) -> None:
-        self.model = load_model()
+    def __init__(self, model: mujoco.MjModel | None = None) -> None:
+        """On the robot-only model, compiled, or ``model`` (one; for several solvers)."""
+        self.model = load_model() if model is None else model
         self.index = RobotIndex.from_model(self.model)
         self.config = mink.Configuration(self.model)
         self.limits = [mink.ConfigurationLimit(self.model)]
@@ -99,8 +102,10 @@ class _Base:
 class ArmIK(_Base):
     """Tool-frame (``hand_palm``) IK over the six PUMA joints."""
 
-    def __init__(self) -> None:
-        super().__init__()
+    MEMO = "arm"  # the memo's name for this solver's results
+
+    def __init__(self, model: mujoco.MjModel | None = None) -> None:
+        super().__init__(model)
         self.task = mink.FrameTask("hand_palm", "site", position_cost=1.0, orientation_cost=0.2)
         hand = [int(d) for d in self.index.hand_dof]
         self.constraints = [mink.DofFreezingTask(self.model, dof_indices=hand)]
@@ -131,7 +136,7 @@ class ArmIK(_Base):
                 [self.task],
                 DT,
                 SOLVER,
-                damping=1e-3,
+                damping=DAMPING,
                 limits=self.limits,
                 constraints=self.constraints,
             )
@@ -142,7 +147,7 @@ class ArmIK(_Base):
         self, pos: FloatArray, rot: FloatArray, arm_q: FloatArray, iterations: int = 2
     ) -> FloatArray:
         """A few warm-started steps from ``arm_q`` toward the pose: one waypoint of a line."""
-        key = _Memo.key("arm-track", pos, rot, arm_q, iterations)
+        key = _Memo.key(f"{self.MEMO}-track", pos, rot, arm_q, iterations)
         known = _MEMO.get(key)
         if isinstance(known, np.ndarray):
             return known.copy()
@@ -161,14 +166,14 @@ class ArmIK(_Base):
         converges wins. Deterministic.
         """
         start = np.asarray(arm_q, dtype=np.float64)
-        key = _Memo.key("arm-solve", pos, rot, start)
+        key = _Memo.key(f"{self.MEMO}-solve", pos, rot, start)
         known = _MEMO.get(key)
         closest = known if isinstance(known, tuple) else (np.inf, np.inf)
         if isinstance(known, np.ndarray):
             return known.copy()
         for offset in _SEEDS if known is None else ():
             self._set(start + offset)
-            perr, rerr = self._iterate(pos, rot, 200)
+            perr, rerr = self._iterate(pos, rot, SOLVE_ITERATIONS)
             if perr <= 2e-3 and rerr <= 1e-2:
                 q: FloatArray = self.config.q[self.index.arm_qpos].copy()
                 _MEMO.put(key, q.copy())
@@ -199,8 +204,8 @@ _SEEDS: tuple[FloatArray, ...] = tuple(
 class FingerIK(_Base):
     """Fingertip-position IK over one finger's four joints, the rest of the robot frozen."""
 
-    def __init__(self) -> None:
-        super().__init__()
+    def __init__(self, model: mujoco.MjModel | None = None) -> None:
+        super().__init__(model)
         ix = self.index
         self.tasks = [
             mink.FrameTask(f"hand_{f}_tip", "site", position_cost=1.0, orientation_cost=0.0)
@@ -253,7 +258,7 @@ class FingerIK(_Base):
                 [task],
                 DT,
                 SOLVER,
-                damping=1e-3,
+                damping=DAMPING,
                 limits=self.limits,
                 constraints=[self.constraints[finger]],
             )

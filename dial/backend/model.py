@@ -78,13 +78,34 @@ def load_model(path: str | Path = ROBOT_XML) -> mujoco.MjModel:
 
 
 def _compile(path: str | Path) -> mujoco.MjModel:
-    # `dial check` reads the XML without MuJoCo (well-formed, bodies named); what only
-    # MuJoCo's compiler finds (a bad attribute value, say) must still reach the user as a line.
     try:
         return mujoco.MjModel.from_xml_path(str(path), _robot_files())
     except ValueError as e:
-        why = "; ".join(line.strip() for line in str(e).splitlines() if line.strip())
-        raise DialError(f"{path}: MuJoCo cannot compile the model: {why}") from None
+        raise _compile_error(path, e) from None
+
+
+def load_untextured(path: str | Path) -> mujoco.MjModel:
+    """Compile a scene without its textures, for what never draws it (``dial preview``).
+
+    A scene's skybox and floor textures take most of its compile time; without them only the
+    textures' fields, the materials' references to them and the name addresses differ.
+    """
+    try:
+        spec = mujoco.MjSpec.from_file(str(path), _robot_files())
+        for material in spec.materials:
+            material.textures = [""] * len(material.textures)
+        for texture in list(spec.textures):
+            spec.delete(texture)
+        return spec.compile()
+    except ValueError as e:
+        raise _compile_error(path, e) from None
+
+
+def _compile_error(path: str | Path, e: ValueError) -> DialError:
+    # `dial check` reads the XML without MuJoCo (well-formed, bodies named); what only
+    # MuJoCo's compiler finds (a bad attribute value, say) must still reach the user as a line.
+    why = "; ".join(line.strip() for line in str(e).splitlines() if line.strip())
+    return DialError(f"{path}: MuJoCo cannot compile the model: {why}")
 
 
 def load_model_from_string(xml: str) -> mujoco.MjModel:

@@ -21,8 +21,9 @@ from dial.scheduler.runner import periods_per_tick
 
 def preview(script: Script, storyboard: Path | None = None) -> PreviewResult:
     """Preview ``script`` in its scene; with ``storyboard``, draw a panel per block there."""
-    scene = Scene(script_world(script))
-    walk = Walk(scene, periods_per_tick(script.tick or DEFAULT_TICK, CONTROL_PERIOD))
+    scene = Scene(script_world(script), textures=storyboard is not None)
+    ticks = periods_per_tick(script.tick or DEFAULT_TICK, CONTROL_PERIOD)
+    walk = Walk(scene, ticks, traces=storyboard is not None)
     walk.steps(script, script.timeline, "")
     panels = 0
     if storyboard is not None:

@@ -23,10 +23,11 @@ import numpy as np
 from dial.backend.ik import IKError
 from dial.instructions.types import FINGERS
 from dial.parser.script import EventDef
-from dial.preview.places import statement_place
+from dial.preview.places import Places
 from dial.preview.scene import HAND, Scene, State, finger_group
 from dial.primitives.arm import Planner, PumaCommand
-from dial.scheduler.types import Outcome
+from dial.primitives.context import Context
+from dial.scheduler.types import Outcome, RunInfo
 
 STEP = 0.002  # m: the step of a guarded move's line
 BISECT = 5  # halvings of the last step once a guarded move touches (to 0.06 mm)
@@ -53,6 +54,10 @@ class PreviewPuma(PumaCommand):
     problems: list[str]
     targets: int  # statements planned, reachable or not
 
+    def __init__(self, ctx: Context, info: RunInfo, places: Places) -> None:
+        super().__init__(ctx, info)
+        self.places = places  # where statements are written (the walk's)
+
     def plan(self, planner: Planner) -> None:
         self.labels, self.problems, self.targets = [], [], 1
         if self.arg("verb") != "ex":
@@ -64,7 +69,7 @@ class PreviewPuma(PumaCommand):
         world = self.ctx.world
         self.targets = len(world.programs[name].statements)
         for st in world.programs[name].statements:
-            place = statement_place(world.path, name, st.line)
+            place = self.places.statement(world.path, name, st.line)
             where = f"program {name} line {st.line}" + (f", {place}" if place else "")
             before = len(planner.segments)
             try:

@@ -17,10 +17,11 @@ import numpy as np
 
 from dial.backend.driver import MujocoRobot
 from dial.backend.ik import ArmIK
-from dial.backend.model import ARM_HOME, load_model
+from dial.backend.model import ARM_HOME, load_model, load_untextured
 from dial.backend.snapshot import FloatArray
 from dial.engine.setup import scene_bodies
 from dial.instructions.types import FINGERS
+from dial.preview.ik import FingerIKOnDemand, LeanArmIK
 from dial.primitives import Context
 from dial.scene.world import World
 from dial.teach.contacts import FIXED_DEPTH, OBJECT_DEPTH, Parts
@@ -63,9 +64,8 @@ class Held:
     """Bodies carried with the palm: their poses in the tool frame, and the grip holding them."""
 
     bodies: tuple[int, ...]
-    adr: np.ndarray  # (N, 7) qpos addresses of each body's free joint
-    pos: FloatArray  # (N, 3) positions in the tool frame
-    quat: FloatArray  # (N, 4) orientations in the tool frame
+    adr: np.ndarray  # (7N,) qpos addresses of the bodies' free joints
+    local: FloatArray  # (N, 7) their positions and orientations (w, x, y, z) in the tool frame
     fingers: frozenset[int]
     closed: FloatArray  # (16,) the hand's joint angles when it closed
 
@@ -81,24 +81,31 @@ class State:
 
 
 class Scene:
-    """One scene's model and data, posed kinematically; the robot starts at ``home``."""
+    """One scene's model and data, posed kinematically; the robot starts at ``home``.
 
-    def __init__(self, world: World) -> None:
+    Without ``textures`` (only drawing needs them) the scene compiles several times faster.
+    """
+
+    def __init__(self, world: World, textures: bool = True) -> None:
         self.world = world
-        self.model = model = load_model(world.model_path)
+        load = load_model if textures else load_untextured
+        self.model = model = load(world.model_path)
         self.data = data = mujoco.MjData(model)
-        mujoco.mj_forward(model, data)
+        mujoco.mj_kinematics(model, data)  # the objects' poses: all the preview reads
         believed = {
             model.body(b).name: (data.xpos[b].copy(), data.xmat[b].reshape(3, 3).copy())
             for b in scene_bodies(model, world)
         }
         self.robot = robot = MujocoRobot(model, data)
         self.index = robot.index
-        ik = ArmIK()
+        ik = LeanArmIK()  # the run's IK to rounding, faster; the fingers' on the same model
         pos, rot = home_pose(world, believed)
-        home = ik.solve(pos, rot, np.array(ARM_HOME), "the start pose (location 'home')")
+        # The start pose by the run's own IK: where a statement planned from it starts is
+        # then the run's to the bit (what a target out of reach reports depends on that).
+        what = "the start pose (location 'home')"
+        home = ArmIK(ik.model).solve(pos, rot, np.array(ARM_HOME), what)
         robot.arm_target = home
-        self.ctx = Context(robot, world, believed, ik)
+        self.ctx = Context(robot, world, believed, ik, FingerIKOnDemand(ik.model))
         self.parts = parts = Parts.of(model, robot.index)
         names = [model.body(b).name for b in range(model.nbody)]
         group = np.where(parts.arm, ARM, np.where(parts.robot, PALM, -1))
@@ -106,18 +113,32 @@ class Scene:
             mine = np.array([names[b].startswith(f"hand_{finger}_") for b in model.geom_bodyid])
             group[mine & parts.robot] = finger_group(f)
         self.group = group
+        self._groups: list[int] = group.tolist()
+        self._nothing = [False] * model.ngeom
         _robot_contacts_only(model, parts.robot)
         self.root = model.body_rootid[model.geom_bodyid]  # each geom's top body
         self.held: tuple[Held, ...] = ()
+        self._released: tuple[bytes, tuple[Held, ...]] = (b"", ())  # hand and grips last let go
+        self._carried: tuple[tuple[Held, ...], list[bool]] = ((), [])
+        arm_lo, arm_hi = robot.arm_range.T.copy()
+        hand_lo, hand_hi = robot.hand_range.T.copy()
+        self._limits = (arm_lo, arm_hi, hand_lo, hand_hi)
+        self._qpos, self._tool_xpos = data.qpos, data.site_xpos[robot.index.tool_site]  # views
+        self._hand = b""  # the hand set-points in qpos
         self.pose()
 
     # -- posing ------------------------------------------------------------------------------------
     def pose(self) -> None:
         """Put the robot at its set-points (carrying what it holds) and find the contacts."""
         m, d, ix, r = self.model, self.data, self.index, self.robot
+        arm_lo, arm_hi, hand_lo, hand_hi = self._limits
         # The servos stop at the joint limits (a target beyond one is reported by the checks).
-        d.qpos[ix.arm_qpos] = np.clip(r.arm_target, r.arm_range[:, 0], r.arm_range[:, 1])
-        d.qpos[ix.hand_qpos] = np.clip(r.hand_target, r.hand_range[:, 0], r.hand_range[:, 1])
+        qpos = self._qpos
+        qpos[ix.arm_qpos] = np.minimum(np.maximum(r.arm_target, arm_lo), arm_hi)
+        hand = r.hand_target.tobytes()
+        if hand != self._hand:  # the hand seldom moves
+            qpos[ix.hand_qpos] = np.minimum(np.maximum(r.hand_target, hand_lo), hand_hi)
+            self._hand = hand
         mujoco.mj_kinematics(m, d)
         if self.held:
             self._let_go()
@@ -130,53 +151,66 @@ class Scene:
         site = self.index.tool_site
         return self.data.site_xpos[site].copy(), self.data.site_xmat[site].reshape(3, 3).copy()
 
+    def tool_position(self) -> FloatArray:
+        position: FloatArray = self._tool_xpos.copy()
+        return position
+
     def tip(self, finger: int) -> FloatArray:
         tip: FloatArray = self.data.site_xpos[self.index.fingertip_sites[finger]].copy()
         return tip
 
     # -- contacts ----------------------------------------------------------------------------------
-    def _contacts(self) -> list[tuple[int, int, float]]:
-        """(robot geom, other geom, depth m) of every penetrating contact of the robot."""
+    def _contacts(self, held: bool = True) -> list[tuple[int, int, float]]:
+        """(robot geom, other geom, depth m) of every penetrating contact of the robot;
+        without ``held``, not those with what the hand holds. (A few contacts at most: a
+        loop over them is cheaper than array operations.)"""
         n = self.data.ncon
         if n == 0:
             return []
-        c = self.data.contact
-        g1, g2, dist = c.geom1[:n], c.geom2[:n], c.dist[:n]
-        keep = ((self.group[g1] >= 0) | (self.group[g2] >= 0)) & (dist < 0)
+        c, group = self.data.contact, self._groups
+        carried = self._held_geoms() if not held and self.held else self._nothing
+        g1, g2, dist = c.geom1[:n].tolist(), c.geom2[:n].tolist(), c.dist[:n].tolist()
         out = []
-        for a, b, d in zip(g1[keep], g2[keep], dist[keep], strict=True):
-            ga, gb = self.group[a], self.group[b]
+        for a, b, d in zip(g1, g2, dist, strict=True):
+            ga, gb = group[a], group[b]
+            if d >= 0 or (ga < 0 and gb < 0) or carried[a] or carried[b]:
+                continue
             first = ga >= 0 and (gb < 0 or ga <= gb)  # the robot's geom first, the arm's first
-            out.append((int(a), int(b), -float(d)) if first else (int(b), int(a), -float(d)))
+            out.append((a, b, -d) if first else (b, a, -d))
         return out
+
+    def _held_geoms(self) -> list[bool]:
+        """Whether each geom belongs to what the hand holds."""
+        grips, mask = self._carried
+        if grips is not self.held:
+            mask = np.isin(self.root, list(self.held_bodies())).tolist()
+            self._carried = (self.held, mask)
+        return mask
 
     def touches(self, groups: Collection[int], held: bool = True) -> set[int]:
         """The geoms that geoms of ``groups`` touch now (other robot parts included); without
         ``held``, not those of what the hand holds."""
-        skip = set() if held else self.held_bodies()
         out: set[int] = set()
-        for a, b, _ in self._contacts():
+        for a, b, _ in self._contacts(held):
             for mine, other in ((a, b), (b, a)):
-                mine_in = self.group[mine] in groups
-                if mine_in and self.group[other] not in groups and self.root[other] not in skip:
+                if self._groups[mine] in groups and self._groups[other] not in groups:
                     out.add(other)
         return out
 
     def touching(self, groups: Collection[int], held: bool = True) -> bool:
         """Whether parts of ``groups`` touch the world or an object (not the robot; without
         ``held``, not what the hand holds)."""
-        return any(self.group[g] < 0 for g in self.touches(groups, held))
+        return any(self._groups[g] < 0 for g in self.touches(groups, held))
 
     def hits(self) -> list[Hit]:
         """The contacts that are problems (see docs/debugging.md), one per pair of parts."""
-        held = self.held_bodies()
         out = []
-        for a, b, depth in self._contacts():
-            ga, gb = int(self.group[a]), int(self.group[b])
-            pair = f"{self._name(a)} and {self._name(b)}"
+        for a, b, depth in self._contacts(held=False):
+            ga, gb = self._groups[a], self._groups[b]
             if gb >= 0:  # the robot against itself (parent and child never collide)
                 if ga == gb or depth <= SELF_DEPTH:
                     continue
+                pair = f"{self._name(a)} and {self._name(b)}"
                 if ga == ARM:
                     text = f"the hand hits the arm ({pair})"
                 elif ga == PALM:
@@ -185,9 +219,7 @@ class Scene:
                     text = f"the {_PART[ga]} and the {_PART[gb]} collide ({pair})"
                 out.append(Hit(_effectors(ga, gb), ("self", _PART[ga], _PART[gb]), text, depth))
                 continue
-            if self.root[b] in held:
-                continue
-            other = self._other(b)
+            other, pair = self._other(b), f"{self._name(a)} and {self._name(b)}"
             if ga == ARM:
                 kind, text = "arm", f"the arm hits {other} ({pair})"
             elif self.parts.fixed[b] and depth > FIXED_DEPTH:
@@ -235,13 +267,13 @@ class Scene:
         m, d = self.model, self.data
         carried = sorted(set(bodies) | self._contents(bodies))
         pos, rot = self.tool()
-        adr = m.jnt_qposadr[m.body_jntadr[carried]][:, None] + np.arange(7)
-        quat = np.empty((len(carried), 4))
+        adr = (m.jnt_qposadr[m.body_jntadr[carried]][:, None] + np.arange(7)).ravel()
+        local = np.empty((len(carried), 7))
+        local[:, :3] = (d.xpos[carried] - pos) @ rot
         for i, b in enumerate(carried):
-            mujoco.mju_mat2Quat(quat[i], (rot.T @ d.xmat[b].reshape(3, 3)).reshape(-1))
-        offsets = (d.xpos[carried] - pos) @ rot
+            mujoco.mju_mat2Quat(local[i, 3:], (rot.T @ d.xmat[b].reshape(3, 3)).reshape(-1))
         hand = self.robot.hand_target.copy()
-        grip = Held(tuple(carried), adr, offsets, quat, frozenset(fingers), hand)
+        grip = Held(tuple(carried), adr, local, frozenset(fingers), hand)
         self.held = (*self.held, grip)
 
     def _contents(self, bodies: Collection[int]) -> set[int]:
@@ -269,20 +301,31 @@ class Scene:
     def _let_go(self) -> None:
         """Drop the grips whose fingers opened."""
         flex = self.robot.hand_target
+        hand, grips = self._released
+        if grips is self.held and hand == flex.tobytes():  # as the last time
+            return
         kept = []
         for grip in self.held:
             joints = [4 * f + j for f in grip.fingers for j in (1, 2, 3)]
             if not np.any(flex[joints] < grip.closed[joints] - RELEASE):
                 kept.append(grip)
         self.held = tuple(kept)
+        self._released = (flex.tobytes(), self.held)
 
     def _carry(self) -> None:
-        pos, rot = self.tool()
+        """Pose what the hand holds: (N, 7) tool-frame poses times one 7 x 7 block matrix,
+        the tool's rotation for positions and its quaternion product for orientations."""
+        d, site = self.data, self.index.tool_site
         tool = np.empty(4)
-        mujoco.mju_mat2Quat(tool, rot.reshape(-1))
+        mujoco.mju_mat2Quat(tool, d.site_xmat[site])
+        w, x, y, z = tool.tolist()
+        block = np.zeros((7, 7))
+        block[:3, :3] = d.site_xmat[site].reshape(3, 3).T
+        block[3:, 3:] = ((w, x, y, z), (-x, w, z, -y), (-y, -z, w, x), (-z, y, -x, w))
+        shift = np.zeros(7)
+        shift[:3] = d.site_xpos[site]
         for grip in self.held:
-            self.data.qpos[grip.adr[:, :3]] = pos + grip.pos @ rot.T
-            self.data.qpos[grip.adr[:, 3:]] = _quat_products(tool, grip.quat)
+            d.qpos[grip.adr] = (grip.local @ block + shift).ravel()
 
     # -- branches ----------------------------------------------------------------------------------
     def save(self) -> State:
@@ -293,6 +336,7 @@ class Scene:
         self.robot.arm_target = state.arm.copy()
         self.robot.hand_target = state.hand.copy()
         self.data.qpos[:] = state.qpos
+        self._hand = b""
         self.held = state.held
         self.pose()
 
@@ -304,21 +348,6 @@ def _robot_contacts_only(model: mujoco.MjModel, robot: np.ndarray) -> None:
     model.geom_contype[colliding & robot] |= 2
     model.geom_contype[colliding & ~robot] = 0
     model.geom_conaffinity[colliding & ~robot] = 2
-
-
-def _quat_products(a: FloatArray, b: FloatArray) -> FloatArray:
-    """The quaternion products a * b[i] (w, x, y, z), for one ``a`` (4,) and ``b`` (N, 4)."""
-    w, x, y, z = a
-    bw, bx, by, bz = b.T
-    return np.stack(
-        [
-            w * bw - x * bx - y * by - z * bz,
-            w * bx + x * bw + y * bz - z * by,
-            w * by - x * bz + y * bw + z * bx,
-            w * bz + x * by - y * bx + z * bw,
-        ],
-        axis=1,
-    )
 
 
 def _box(m: mujoco.MjModel, d: mujoco.MjData, geom: int) -> tuple[FloatArray, FloatArray]:

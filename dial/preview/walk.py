@@ -28,12 +28,12 @@ from dial.parser.ast import Condition
 from dial.parser.script import EventDef, Run, Script, Step, TBlock, TCall, TIf, TOn, TRepeat, Watch
 from dial.preview import checks
 from dial.preview.motions import PreviewPuma, Report, grasp, guarded, sense
-from dial.preview.places import Place
+from dial.preview.places import Place, Places
 from dial.preview.report import Counts, Problems
 from dial.preview.scene import Hit, Scene, State, finger_group
 from dial.primitives import CLASSES
 from dial.primitives.arm import ArmMotion
-from dial.scheduler.types import Now, Outcome, Primitive, RunInfo
+from dial.scheduler.types import Course, Now, Outcome, Primitive, RunInfo
 
 ARM_STEP = np.radians(0.25)  # rad of any arm joint between two checks of a moving pose
 HAND_STEP = np.radians(1.0)  # rad of any hand joint
@@ -78,8 +78,9 @@ class Panel:
 class Walk:
     """Walks a script's timeline over a :class:`Scene`; collects problems and panels."""
 
-    def __init__(self, scene: Scene, periods_per_tick: int) -> None:
-        self.scene, self.n = scene, periods_per_tick
+    def __init__(self, scene: Scene, periods_per_tick: int, traces: bool = True) -> None:
+        """``traces``: keep the tool's path through each block (only a storyboard draws it)."""
+        self.scene, self.n, self.traces = scene, periods_per_tick, traces
         self.problems = Problems()
         self.counts = Counts()
         self.panels: list[Panel] = []
@@ -93,6 +94,7 @@ class Walk:
         self.trace: list[FloatArray] = []
         self.ongoing: dict[tuple[str, str, str], tuple[Place, str]] = {}
         self.seen = (scene.robot.arm_target.copy(), scene.robot.hand_target.copy())
+        self.places = Places()  # statement places, the world files read once per preview
 
     # -- the timeline ------------------------------------------------------------------------------
     def steps(self, script: Script, steps: tuple[Step, ...], label: str) -> None:
@@ -193,12 +195,12 @@ class Walk:
             self.clock += self.n
             return None
         snapshot = self.scene.robot.snapshot()
-        for _ in range(self.n):
+        writes = [self.course(a, k, snapshot) for a in moving]
+        for i in range(self.n):
             self.clock += 1
-            for a in moving:
-                done = (self.clock - a.start_clock) / a.span  # a one-tick run: a GOTO
-                a.progress = 1.0 if a.span == self.n else min(1.0, done)
-                a.prim.step(snapshot, Now(0.0, k, a.progress, 0.0, False))
+            for a, write in zip(moving, writes, strict=True):
+                a.progress = self.progress(a, self.clock)
+                write(i)
             if armed:
                 self.look()
                 fired = self.fires(script, block, armed)
@@ -207,6 +209,23 @@ class Walk:
             else:
                 self.glance()
         return None
+
+    def progress(self, a: Active, clock: int) -> float:
+        """A run's progress in tick time at the end of period ``clock``, as the runner has it
+        (a one-tick run: a GOTO)."""
+        return 1.0 if a.span == self.n else min(1.0, (clock - a.start_clock) / a.span)
+
+    def course(self, a: Active, k: int, snapshot: Snapshot) -> Course:
+        """A writer of the run's set-points in the ``i``-th period of tick ``k``: an open-loop
+        run's course (what its step would write, bit for bit, worked out for the whole tick
+        at once), else its step."""
+        if a.prim.open_loop:
+            return a.prim.course([self.progress(a, self.clock + i) for i in range(1, self.n + 1)])
+
+        def step(i: int) -> None:
+            a.prim.step(snapshot, Now(0.0, k, a.progress, 0.0, False))
+
+        return step
 
     def fires(self, script: Script, block: TBlock, armed: list[Watch]) -> TOn | None:
         """The first ``@on`` (in file order) whose watched contact condition holds now."""
@@ -276,7 +295,9 @@ class Walk:
         """The run's own primitive; ``puma_command``'s planned a statement at a time."""
         name = info.event.instruction.primitive
         ctx = self.scene.ctx
-        made = PreviewPuma(ctx, info) if name == "PumaCommand" else CLASSES[name](ctx, info)
+        if name == "PumaCommand":
+            return PreviewPuma(ctx, info, self.places)
+        made = CLASSES[name](ctx, info)
         assert isinstance(made, Primitive), "a fixed-length instruction has a primitive"
         return made
 
@@ -309,9 +330,10 @@ class Walk:
     def glance(self) -> None:
         """Look at the pose if it moved enough since it was last looked at."""
         arm, hand = self.scene.robot.arm_target, self.scene.robot.hand_target
-        if (
-            np.abs(arm - self.seen[0]).max() > ARM_STEP
-            or np.abs(hand - self.seen[1]).max() > HAND_STEP
+        seen_arm, seen_hand = self.seen
+        if max(map(abs, (arm - seen_arm).tolist())) > ARM_STEP or (
+            hand.tobytes() != seen_hand.tobytes()  # the hand seldom moves: compare it fast
+            and np.abs(hand - seen_hand).max() > HAND_STEP
         ):
             self.look()
 
@@ -323,7 +345,8 @@ class Walk:
         """Record the posed scene's problems, each on the run that caused it."""
         robot = self.scene.robot
         self.seen = (robot.arm_target.copy(), robot.hand_target.copy())
-        self.trace.append(self.scene.tool()[0])
+        if self.traces:
+            self.trace.append(self.scene.tool_position())
         ongoing: dict[tuple[str, str, str], tuple[Place, str]] = {}
         for hit in self.scene.hits():
             # A contact that goes on from the last look stays with the run that made it.

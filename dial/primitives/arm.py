@@ -15,13 +15,14 @@ import math
 from abc import abstractmethod
 from collections.abc import Sequence
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
 from dial.backend.ik import recall, remember
 from dial.backend.slots import still
 from dial.backend.snapshot import FloatArray, Snapshot
-from dial.geometry import rpy_matrix, slerp, smooth, smooth_array
+from dial.geometry import Slerp, rpy_matrix, smooth, smooth_array
 from dial.primitives.context import Context, RobotPrimitive
 from dial.scene.valii import Appro, Depart, Drive, Move, Statement
 from dial.scheduler.types import DONE, Course, Ended, Now, Outcome, RunInfo
@@ -60,9 +61,14 @@ class Segment:
         if x >= last:  # exactly the goal (a + (b - a) * 1 may be a bit off)
             return self.q1.copy()
         k = int(x)
-        a, b = self.waypoints[k], self.waypoints[k + 1]
-        out: FloatArray = a + (b - a) * (x - k)
+        out: FloatArray = self.waypoints[k] + self.steps[k] * (x - k)
         return out
+
+    @cached_property
+    def steps(self) -> FloatArray:
+        """(N, 6): each waypoint's difference to the next (b - a, worked out once)."""
+        steps: FloatArray = self.waypoints[1:] - self.waypoints[:-1]
+        return steps
 
     def at_array(self, u: FloatArray) -> FloatArray:
         """(K, 6): :meth:`at` of each fraction, bit for bit."""
@@ -92,7 +98,8 @@ class Planner:
         """A straight tool line to the pose, as IK waypoints. A line depends only on its
         start and goal (the solves are deterministic), so a line planned before in this
         process (a sweep's trials, a loop's passes) is taken whole from the IK's memo."""
-        key, known = recall("arm-line", self.q, p1, r1)
+        # Under the IK's own name: the preview's IK (dial.preview.ik) answers to rounding only.
+        key, known = recall(f"{self.ctx.arm_ik.MEMO}-line", self.q, p1, r1)
         if not isinstance(known, Segment):
             self._line(p1, r1, what)
             known = self.segments.pop()
@@ -108,10 +115,10 @@ class Planner:
         length = float(np.linalg.norm(p1 - p0))
         turn = float(np.arccos(np.clip((np.trace(r0.T @ r1) - 1.0) / 2.0, -1.0, 1.0)))
         n = max(1, math.ceil(max(length / LINE_STEP, turn / LINE_TURN_STEP)))
-        waypoints = [self.q]
+        waypoints, turning = [self.q], Slerp(r0, r1)
         for k in range(1, n):
             u = k / n
-            waypoints.append(ik.track(p0 + (p1 - p0) * u, slerp(r0, r1, u), waypoints[-1]))
+            waypoints.append(ik.track(p0 + (p1 - p0) * u, turning(u), waypoints[-1]))
         waypoints.append(q1)
         cost = max(length / LINEAR_SPEED, turn / TURN_SPEED)
         self.segments.append(Segment(np.stack(waypoints), cost))
