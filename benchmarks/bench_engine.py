@@ -5,6 +5,9 @@ Prints:
   `mj_step` loop over the same physics steps on the same scene (target <= 1.25, goal 1.10).
   The bare loop replays the run's own controls from the run's own start state, so it steps
   exactly the same physics (the same contacts, the same grasp): what remains is dial's cost.
+  It replays on the run's own MjModel and MjData, right after the run: on a copy of its own,
+  where the allocator happened to put the two moved the ratio by up to +-0.02 from one
+  invocation of this script to the next.
   Runs and replays alternate K times (a noisy neighbour slows a pair alike); the median of
   the pairs' ratios is the figure, the best run over the best replay is printed beside it,
   and the ratio of process CPU times. mj_step's own speed drifts by 10-20 % over seconds on a
@@ -27,10 +30,12 @@ Prints:
 from __future__ import annotations
 
 import argparse
+import importlib
 import tempfile
 import time
 from pathlib import Path
 from types import SimpleNamespace
+from typing import Any
 
 import mujoco
 import numpy as np
@@ -43,6 +48,7 @@ from dial.resources import resolve_script
 from dial.scene import World, load_scene_names, worlds_dir
 from dial.testing import run_fake
 
+engine_run = importlib.import_module("dial.engine.run")  # the module (dial.engine.run is run)
 POUR_BEFORE = Path(__file__).resolve().parent / "pour_before" / "pour_before.toml"
 
 
@@ -77,9 +83,11 @@ class _Replay:
         self.steps = sum(nstep for _, _, nstep in recorder.calls)
         self.sim_time = self.steps * self.model.opt.timestep
 
-    def run(self) -> tuple[float, float]:
-        """Replay once; (wall, process CPU) seconds."""
-        model, data = self.model, self.data
+    def run(self, on: tuple[mujoco.MjModel, mujoco.MjData] | None = None) -> tuple[float, float]:
+        """Replay once, on the replay's own model and data or ``on`` (a run's: the same
+        memory, so that where the allocator put them cannot favour either side); (wall,
+        process CPU) seconds."""
+        model, data = on if on is not None else (self.model, self.data)
         mujoco.mj_copyData(data, model, self.recorder.start)
         t0, c0 = time.perf_counter(), time.process_time()
         for ctrl, eq_active, nstep in self.recorder.calls:
@@ -113,6 +121,24 @@ def _run_with(stand_in: object, script: Script) -> RunResult:
         driver.mujoco = mujoco
 
 
+def _run_keeping(script: Script) -> tuple[RunResult, tuple[mujoco.MjModel, mujoco.MjData]]:
+    """Run ``script`` as dial run does; also return the run's model and data."""
+    kept: list[tuple[mujoco.MjModel, mujoco.MjData]] = []
+    original = engine_run.prepare
+
+    def prepare(*args: Any) -> tuple[driver.MujocoRobot, Any]:
+        robot, ctx = original(*args)
+        kept.append((robot.model, robot.data))
+        return robot, ctx
+
+    engine_run.prepare = prepare
+    try:
+        result = run(script, RunOptions())
+    finally:
+        engine_run.prepare = original
+    return result, kept[0]
+
+
 def _record(script: Script) -> tuple[RunResult, _Replay]:
     """One run with the step recorder (not timed: the recorder has its own cost)."""
     recorder = _StepRecorder()
@@ -128,20 +154,20 @@ def engine_overhead(script_arg: str | Script, repeat: int) -> tuple[World, _Repl
     else:
         script = load(resolve_script(script_arg), loader=load_scene_names)
     _, replay = _record(script)
-    model, data = replay.model, replay.data
+    model = replay.model
 
     # Interleaved pairs, so that a noisy neighbour slows a run and its replay alike.
     walls, replays, cpu_ratios, inside = [], [], [], []
     for _ in range(repeat):
-        result = _run_with(mujoco, script)  # as dial run runs: nothing timed inside
-        bare_wall, bare_cpu = replay.run()
+        result, physics = _run_keeping(script)  # as dial run runs: nothing timed inside
+        bare_wall, bare_cpu = replay.run(on=physics)
         walls.append(result.wall_time)
         replays.append(bare_wall)
         cpu_ratios.append(result.cpu_time / bare_cpu)
         timer = _StepTimer()  # a run of its own: timing each call costs time too
         timed = _run_with(timer, script)
         inside.append(timed.wall_time / timer.seconds)
-    same = np.array_equal(data.qpos, np.array(result.final_qpos))
+    same = np.array_equal(physics[1].qpos, np.array(result.final_qpos))  # replayed last
     steps = result.physics_steps
     rest = mujoco.MjData(model)
     mujoco.mj_forward(model, rest)

@@ -156,16 +156,17 @@ class MujocoRobot:
             mujoco.mj_step(m, d, nstep=self.substeps)
             self.steps += self.substeps
         else:
+            armed, threads = self.guards.armed, self.threads  # read after every physics step
             for _ in range(self.substeps):
                 if due:
                     self.disturbances.apply(self.steps, d, self._happened, self.time)
                 mujoco.mj_step(m, d)
                 self.steps += 1
-                for thread in self.threads:
+                for thread in threads:
                     if thread.update(d):
                         fields = {"name": thread.name, "t": self.time, "step": self.steps}
                         self._happened.append(Happening("thread", fields))
-                if self.guards:
+                if armed:
                     self._check_guards()
         fault = self.safety.check(self.time, self._happened)
         if fault is None and not self._happened and not self._fired:
@@ -191,6 +192,7 @@ class MujocoRobot:
         arm_only = not self._limping and all(isinstance(w, ArmCourse) for w in writes)
         ctrl, arm_ctrl = d.ctrl, self._arm_ctrl
         self._apply()
+        steps, dt = self.steps, self._dt
         for k in range(periods):
             for write in writes:
                 write(k)
@@ -199,8 +201,8 @@ class MujocoRobot:
             else:
                 self._apply()
             mujoco.mj_step(m, d, nstep=n)
-            self.steps += n
-            fault = safety.check(self.steps * self._dt, happened)
+            self.steps = steps = steps + n
+            fault = safety.check(steps * dt, happened)
             if fault is not None or happened:
                 report = Report(fault, tuple(happened))
                 happened.clear()
