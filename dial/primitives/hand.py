@@ -67,20 +67,25 @@ class GraspForce(RobotPrimitive):
         self.stopped: dict[int, float] = {}
         self.jbits, self.tbits = _bits(self.jmask), _bits(self.tmask)
         self.monitored = {k // 4 for k in self.tbits} or set(self.fingers)
+        # The set-points as Python floats: a few joints a period, cheaper than numpy's calls.
+        self.q, self.limits = self.target.tolist(), self.upper.tolist()
+        self.closing = list(self.jbits)  # the joints of the fingers not stopped yet
 
     def step(self, snapshot: Snapshot, now: Now) -> Ended | None:
         diff = snapshot.differentials.tolist()
+        stopped = self.stopped
         for f in self.fingers:
-            if f not in self.stopped and max(diff[k] for k in self.watched[f]) >= self.force:
-                self.stopped[f] = now.sim_time
-        closing = [k for k in self.jbits if k // 4 not in self.stopped]
-        self.target[closing] = np.minimum(self.target[closing] + self.rate, self.upper[closing])
+            if f not in stopped and max(diff[k] for k in self.watched[f]) >= self.force:
+                stopped[f] = now.sim_time
+                self.closing = [k for k in self.jbits if k // 4 not in stopped]
+        q, limits, rate, closing = self.q, self.limits, self.rate, self.closing
+        for k in closing:
+            q[k] = min(q[k] + rate, limits[k])
+        self.target[:] = q
         self.slots.joints(self.jmask, self.target)
-        if self.monitored <= self.stopped.keys():
+        if self.monitored <= stopped.keys():
             return done(forces=self._forces(diff))
-        if all(self.target[k] >= self.upper[k] for k in closing) and not (
-            self.monitored & self.stopped.keys()
-        ):
+        if all(q[k] >= limits[k] for k in closing) and not (self.monitored & stopped.keys()):
             message = "the fingers closed fully without reaching the force"
             return missed(message, forces=self._forces(diff))
         return None
