@@ -90,6 +90,14 @@ class Safety:
         self.saturation_logged = held | (self.saturation_logged & pinned)
         return None
 
+    def restore(self, saturated_since: np.ndarray, saturation_logged: np.ndarray) -> None:
+        """Take up the tendon timers of a saved run (state files): tracked again at once if a
+        tendon was pinned or logged, as the run that saved them would be."""
+        self.saturated_since[:] = saturated_since
+        self.saturation_logged[:] = saturation_logged
+        self._tracking = bool(self.saturation_logged.any() or (self.saturated_since >= 0).any())
+        self._due = self.data.time + self._span
+
     def _beyond(self) -> str:
         """The fault message of the first arm joint beyond its limit."""
         q = self._arm_q().tolist()

@@ -290,9 +290,10 @@ class Saved:
         robot.arm_target = _floats(r["arm_target"], 6, "arm_target")
         robot.hand_target = _floats(r["hand_target"], 16, "hand_target")
         robot.set_limp(slice(None), _flags(r["limp"], robot.limp.size, "limp"))
-        robot.safety.saturated_since[:] = _floats(r["saturated_since"], 32, "saturated_since")
-        logged = robot.safety.saturation_logged
-        logged[:] = _flags(r["saturation_logged"], logged.size, "saturation_logged")
+        robot.safety.restore(
+            _floats(r["saturated_since"], 32, "saturated_since"),
+            _flags(r["saturation_logged"], 32, "saturation_logged"),
+        )
         robot.disturbances.resume_at(robot.steps)
         ctx.point_sets.update(d["contacts"])
         for f, (tactile, link) in d.get("stops", {}).items():

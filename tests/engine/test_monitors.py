@@ -53,3 +53,26 @@ def test_a_tendon_held_at_its_limit_is_logged_once_per_episode() -> None:
     assert len(warnings) == 32  # each tendon once, not once per period
     message = warnings[0].fields["message"]
     assert "index joint 0 flexor tendon held at its 50 N limit for 1 s" in str(message)
+
+
+def test_restored_tendon_timers_go_on_as_the_run_that_saved_them() -> None:
+    """A state file's tendon timers: a resumed robot reports what the saving one goes on to
+    report, also when a tendon was logged as pinned before the save and lets go after it."""
+    saving, resumed = _robot(), _robot()
+    for robot in (saving, resumed):
+        robot.arm_target = robot.data.qpos[robot.index.arm_qpos].copy()
+        robot.safety._pinned_at = 5.0  # below the 10 N pretension: every tendon is pinned
+    for _ in range(150):  # 1.5 s: each tendon logged once
+        saving.advance()
+    assert saving.safety.saturation_logged.all()
+    saving.safety._pinned_at = resumed.safety._pinned_at = 1e9  # nothing is pinned from now
+    state = mujoco.MjData(saving.model)
+    mujoco.mj_copyData(state, saving.model, saving.data)
+    mujoco.mj_copyData(resumed.data, resumed.model, state)
+    resumed.steps = saving.steps
+    resumed.safety.restore(saving.safety.saturated_since, saving.safety.saturation_logged)
+    for _ in range(3):
+        assert resumed.advance() == saving.advance()
+        assert (resumed.safety.saturation_logged == saving.safety.saturation_logged).all()
+        assert (resumed.safety.saturated_since == saving.safety.saturated_since).all()
+    assert not saving.safety.saturation_logged.any()  # let go: the episode ended
