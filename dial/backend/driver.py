@@ -82,6 +82,7 @@ class MujocoRobot:
         tendons = data.ctrl[self._tendon_ctrl]
         self._tendon_pairs = tendons.reshape(16, 2) if tendons.base is not None else None
         self._finger_bodies = tuple(finger_bodies(model, f) for f in range(len(FINGERS)))
+        self._taxel_frames: dict[int, tuple[int, FloatArray]] = {}  # see _taxels
         hand_joints = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, n) for n in HAND_JOINTS]
         self.hand_range = model.jnt_range[hand_joints].copy()  # (16, 2) rad, mask order
         self.hand_range.flags.writeable = False
@@ -265,17 +266,25 @@ class MujocoRobot:
 
     def taxel_points(self, finger: int) -> FloatArray:
         """(256, 3) world positions of a fingertip's taxels, in sensor order (m)."""
-        model, data = self.model, self.data
+        geom, local = self._taxels(finger)
+        rot = self.data.geom_xmat[geom].reshape(3, 3)
+        points: FloatArray = self.data.geom_xpos[geom] + local @ rot.T
+        return points
+
+    def _taxels(self, finger: int) -> tuple[int, FloatArray]:
+        """A fingertip's pad geom and its taxels in the geom's frame (looked up once)."""
+        known = self._taxel_frames.get(finger)
+        if known is not None:
+            return known
+        model = self.model
         sensor = int(
             mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SENSOR, f"hand_{FINGERS[finger]}_tactile")
         )
         # A tactile sensor's object is its mesh; its reference is the geom that carries it.
         mesh, geom = int(model.sensor_objid[sensor]), int(model.sensor_refid[sensor])
         adr, n = int(model.mesh_vertadr[mesh]), int(model.mesh_vertnum[mesh])
-        local = model.mesh_vert[adr : adr + n].astype(np.float64)
-        rot = data.geom_xmat[geom].reshape(3, 3)
-        points: FloatArray = data.geom_xpos[geom] + local @ rot.T
-        return points
+        known = self._taxel_frames[finger] = (geom, model.mesh_vert[adr : adr + n].astype(float))
+        return known
 
     # -- stepping ----------------------------------------------------------------------------------
     def _apply(self) -> None:

@@ -38,21 +38,26 @@ def finger_bodies(model: mujoco.MjModel, finger: int) -> frozenset[int]:
 def link_point(
     model: mujoco.MjModel, data: mujoco.MjData, bodies: frozenset[int]
 ) -> FloatArray | None:
-    """The deepest contact point (3,) between the ``bodies`` and anything outside the robot.
+    """The deepest contact point (3,) between the ``bodies`` and anything outside the robot
+    (the first of equally deep ones, in MuJoCo's contact order).
 
-    None when the finger touches nothing but the robot (or nothing at all)."""
-    best: tuple[float, FloatArray] | None = None
-    robot = _robot_root(model)
-    for contact in data.contact[: data.ncon]:
-        b1, b2 = int(model.geom_bodyid[contact.geom1]), int(model.geom_bodyid[contact.geom2])
-        if (b1 in bodies) == (b2 in bodies):
-            continue  # neither is the finger, or the finger touches itself
-        other = b2 if b1 in bodies else b1
-        if int(model.body_rootid[other]) == robot:
-            continue
-        if best is None or contact.dist < best[0]:
-            best = (float(contact.dist), np.array(contact.pos, dtype=np.float64))
-    return None if best is None else best[1]
+    None when the finger touches nothing but the robot (or nothing at all). The contacts are
+    read as arrays: a scene full of balls has a hundred and more of them."""
+    n = data.ncon
+    if n == 0:
+        return None
+    contacts = data.contact
+    b1 = model.geom_bodyid[contacts.geom1[:n]]
+    b2 = model.geom_bodyid[contacts.geom2[:n]]
+    finger = np.fromiter(bodies, dtype=b1.dtype, count=len(bodies))
+    in1, in2 = np.isin(b1, finger), np.isin(b2, finger)
+    other = np.where(in1, b2, b1)
+    # One side is the finger (not both: the finger touching itself), the other not the robot.
+    hits = np.flatnonzero((in1 != in2) & (model.body_rootid[other] != _robot_root(model)))
+    if len(hits) == 0:
+        return None
+    deepest = hits[np.argmin(contacts.dist[:n][hits])]
+    return np.array(contacts.pos[deepest], dtype=np.float64)
 
 
 def _robot_root(model: mujoco.MjModel) -> int:
