@@ -81,9 +81,18 @@ def test_no_coast_while_a_closed_loop_run_is_active() -> None:
     result = _run(STRETCH, paced=False, options={"behaviours": {"grab": Behaviour(0.27)}})
     # grab runs (closed-loop) through ticks 2 and 3 and stretches tick 3 by 7 periods: the
     # only coasts are tick 1 (arm alone) and the ticks after grab ended.
-    coasts = result.robot.coasts  # type: ignore[attr-defined]
+    coasts = [first for first, _ in result.robot.coasts]  # type: ignore[attr-defined]
     assert coasts[0] == 1
     assert not any(11 <= p <= 37 for p in coasts)
+
+
+def test_a_coast_runs_on_through_quiet_tick_boundaries_and_records_each_tick() -> None:
+    # arm runs ticks 1-6 alone after idx's one tick: from tick 2 on no run starts or ends
+    # before tick 6's end, so one coast takes ticks 2 to 6 (50 periods).
+    result = _run(DEFS + "arm  #=====\nidx  #\n", paced=False, options={})
+    assert (11, 50) in result.robot.coasts  # type: ignore[attr-defined]
+    ticks = [(r["tick"], r["t0"], r["t1"]) for r in result.log.of("tick")]  # type: ignore[attr-defined]
+    assert ticks == [(k, (k - 1) / 10, k / 10) for k in range(1, 7)]
 
 
 def test_smooth_array_is_smooth_bit_for_bit() -> None:

@@ -69,7 +69,7 @@ class FakeRobot:
         self.armed: list[tuple[int, str, bool]] = []  # (period, event, negated), as armed
         self._keys = itertools.count(1)
         self.stops: list[str] = []  # events whose run was stopped, in order
-        self.coasts: list[int] = []  # the first period of each coast (Periods._coast)
+        self.coasts: list[tuple[int, int]] = []  # each coast's first period and length asked
 
     @property
     def period(self) -> float:
@@ -94,7 +94,7 @@ class FakeRobot:
     def coast(
         self, writes: Sequence[Course], periods: int, stop: StopRequest
     ) -> tuple[int, Report | None]:
-        self.coasts.append(self.periods + 1)
+        self.coasts.append((self.periods + 1, periods))
         return advance_through(self, writes, periods, stop)
 
     def hold_all(self) -> None:
