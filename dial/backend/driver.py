@@ -153,7 +153,7 @@ class MujocoRobot:
         self._apply()
         m, d = self.model, self.data
         due = self.disturbances.due(self.steps, self.substeps)
-        if not self.guards and not self.threads and not due:
+        if not self.guards.armed and not self.threads and not due:
             mujoco.mj_step(m, d, nstep=self.substeps)
             self.steps += self.substeps
         else:
@@ -248,7 +248,7 @@ class MujocoRobot:
         self._trips.pop(key, None)
 
     # -- what primitives may ask of the robot (through Slots, or read-only) ----------------------
-    def set_limp(self, joints: slice | list[int], on: bool | NDArray[np.bool_]) -> None:
+    def set_limp(self, joints: slice | IntArray, on: bool | NDArray[np.bool_]) -> None:
         """Make these hand joints (mask order) back-drivable, or stiff."""
         self.limp[joints] = on
         self._limping = bool(self.limp.any())

@@ -7,6 +7,7 @@ from typing import Protocol
 
 import numpy as np
 
+from dial.backend.model import IntArray
 from dial.backend.snapshot import FloatArray
 from dial.errors import DialError
 from dial.instructions.types import FINGERS
@@ -24,7 +25,7 @@ class Commanded(Protocol):
     hand_target: FloatArray  # (16,) rad, mask order
     limp: np.ndarray  # (16,) bool, written through set_limp
 
-    def set_limp(self, joints: list[int], on: bool) -> None: ...
+    def set_limp(self, joints: IntArray, on: bool) -> None: ...
 
     def measured_hand(self) -> FloatArray: ...
 
@@ -61,19 +62,21 @@ class Slots:
 
     def __init__(self, robot: Commanded, effectors: frozenset[str]) -> None:
         self.robot, self.effectors = robot, effectors
-        self._owned: dict[int, list[int]] = {}  # masks checked, and their bits
+        self._owned: dict[int, IntArray] = {}  # masks checked, and their joints
 
     def _own(self, effector: str) -> None:
         if effector not in self.effectors:
             raise EffectorError(f"run does not own the {effector}")
 
-    def _own_bits(self, mask: int) -> list[int]:
+    def _own_bits(self, mask: int) -> IntArray:
+        """The joints of ``mask`` as an index array, their fingers' ownership checked (once
+        per mask: a grasp writes the same one every period)."""
         bits = self._owned.get(mask)
-        if bits is None:  # a grasp writes the same mask every period: check it once
-            bits = _bits(mask)
-            for f in {k // 4 for k in bits}:
+        if bits is None:
+            listed = _bits(mask)
+            for f in {k // 4 for k in listed}:
                 self._own(FINGERS[f])
-            self._owned[mask] = bits
+            bits = self._owned[mask] = np.array(listed, dtype=np.intp)
         return bits
 
     def arm(self, q: FloatArray) -> None:
@@ -94,7 +97,7 @@ class Slots:
 
     def joints_course(self, mask: int, rows: FloatArray) -> Course:
         """A writer of the masked hand joints' set-points from ``rows[k]`` ((K, 16) rad)."""
-        bits = np.array(self._own_bits(mask), dtype=np.intp)
+        bits = self._own_bits(mask)
         masked, robot = rows[:, bits], self.robot
 
         def write(k: int) -> None:
