@@ -169,7 +169,10 @@ class MujocoRobot:
                         self._happened.append(Happening("thread", fields))
                 if armed:
                     self._check_guards()
-        fault = self.safety.check(self.time, self._happened)
+        return self._reported(self.safety.check(self.time, self._happened))
+
+    def _reported(self, fault: str | None) -> Report | None:
+        """The period's report, if anything happened (then the robot's lists start afresh)."""
         if fault is None and not self._happened and not self._fired:
             return None
         report = Report(fault, tuple(self._happened), tuple(self._fired))
@@ -185,7 +188,7 @@ class MujocoRobot:
         stop signal, with the number of periods taken. With no guard, thread or disturbance
         in the way this is :meth:`advance` unrolled, as lean as a period can be."""
         n = self.substeps
-        if self.guards or self.threads or self.disturbances.due(self.steps, periods * n):
+        if self.guards.armed or self.threads or self.disturbances.due(self.steps, periods * n):
             return advance_through(self, writes, periods, stop)
         m, d, safety, happened = self.model, self.data, self.safety, self._happened
         writes = [w for w in writes if w is not still]
@@ -205,9 +208,7 @@ class MujocoRobot:
             self.steps = steps = steps + n
             fault = safety.check(steps * dt, happened)
             if fault is not None or happened:
-                report = Report(fault, tuple(happened))
-                happened.clear()
-                return k + 1, report
+                return k + 1, self._reported(fault)
             if stop.signal is not None:
                 return k + 1, None
         return periods, None

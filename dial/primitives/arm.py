@@ -75,8 +75,7 @@ class Segment:
         last = len(self.waypoints) - 1
         x = np.minimum(1.0, np.maximum(0.0, u)) * last
         k = np.minimum(x.astype(np.intp), last - 1)
-        a, b = self.waypoints[k], self.waypoints[k + 1]
-        out: FloatArray = a + (b - a) * (x - k)[:, None]
+        out: FloatArray = self.waypoints[k] + self.steps[k] * (x - k)[:, None]
         out[x >= last] = self.q1
         return out
 
@@ -210,9 +209,7 @@ class ArmMotion(RobotPrimitive):
         if not self.segments:
             return still
         if self._table is None:
-            info = self.info
-            n = info.periods_per_tick
-            span = (info.run.exec_end - info.run.start + 1) * n
+            n, span = self.info.periods_per_tick, self.info.span
             self._progress = (
                 [1.0] * span if span == n else [min(1.0, k / span) for k in range(1, span + 1)]
             )

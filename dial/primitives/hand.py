@@ -57,7 +57,6 @@ class GraspForce(RobotPrimitive):
         self.force = self.num("force")
         self.rate = self.num("speed") * self.info.period
         self.target = snapshot.hand_target.copy()
-        self.upper = self.ctx.robot.hand_range[:, 1]
         self.fingers = sorted({k // 4 for k in _bits(self.jmask)})
         self.watched = {
             f: [k for k in _bits(self.tmask) if k // 4 == f]
@@ -68,7 +67,7 @@ class GraspForce(RobotPrimitive):
         self.jbits, self.tbits = _bits(self.jmask), _bits(self.tmask)
         self.monitored = {k // 4 for k in self.tbits} or set(self.fingers)
         # The set-points as Python floats: a few joints a period, cheaper than numpy's calls.
-        self.q, self.limits = self.target.tolist(), self.upper.tolist()
+        self.q, self.limits = self.target.tolist(), self.ctx.robot.hand_range[:, 1].tolist()
         self.closing = list(self.jbits)  # the joints of the fingers not stopped yet
 
     def step(self, snapshot: Snapshot, now: Now) -> Ended | None:

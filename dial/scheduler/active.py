@@ -44,13 +44,13 @@ class RunPlan(NamedTuple):
 
     @classmethod
     def of(cls, info: RunInfo) -> RunPlan:
-        run, event = info.run, info.event
+        event = info.event
         fixed = event.instruction.length == "fixed"
         timeout = event.args.get("timeout")
         usable = not fixed and isinstance(timeout, int | float)
         return cls(
             info,
-            (run.exec_end - run.start + 1) * info.periods_per_tick,
+            info.span,
             fixed,
             float(timeout) if usable else None,  # type: ignore[arg-type]
         )

@@ -112,8 +112,7 @@ class Periods(Generic[S]):
             return await self._period(stretched=False), 1
         before = self.periods
         fired = self._coast(writes, most)
-        if self.periods // YIELD_EVERY != before // YIELD_EVERY:
-            await trio.lowlevel.checkpoint()
+        await self._yield_since(before)
         return fired, self.periods - before
 
     def _courses(self, most: int) -> list[Course] | None:
@@ -138,32 +137,40 @@ class Periods(Generic[S]):
     def _coast(self, writes: list[Course], most: int) -> tuple[Fired, ...]:
         """Periods as :meth:`_step` takes them, with the open-loop runs' set-points written
         from their courses; it stops after a period whose report says anything."""
-        robot, observe, stop = self.robot, self.observe, self.stop
-        fired: tuple[Fired, ...] = ()
+        observe = self.observe
         if observe is None:  # the robot's own loop: nothing to do between its periods
-            done, report = robot.coast(writes, most, stop)
-            self.periods += done
-            self.clock += done
-            if report is not None:
-                fired = self._report(report)
-            self._snap = None
-            self._raise_pending()
-            return fired
+            return self._coasted(*self.robot.coast(writes, most, self.stop))
         for k in range(most):
             for write in writes:
                 write(k)
-            report = robot.advance()
+            report = self.robot.advance()
+            if report is not None:
+                return self._coasted(1, report, observe)
             self.periods += 1
             self.clock += 1
-            if report is not None:
-                fired = self._report(report)
-            if observe is not None:
-                observe(self.periods, self.tick)
-            if report is not None or stop.signal is not None:
+            observe(self.periods, self.tick)
+            if self.stop.signal is not None:
                 break
+        return self._coasted(0, None)
+
+    def _coasted(
+        self, periods: int, report: Report | None, observe: Observe | None = None
+    ) -> tuple[Fired, ...]:
+        """Count the last ``periods`` coasted and log what the robot reported after the last
+        of them (then ``observe`` it), as :meth:`_step` does; stop the script if need be."""
+        self.periods += periods
+        self.clock += periods
+        fired = () if report is None else self._report(report)
+        if observe is not None:
+            observe(self.periods, self.tick)
         self._snap = None
         self._raise_pending()
         return fired
+
+    async def _yield_since(self, periods: int) -> None:
+        """Let trio's other tasks run if a multiple of YIELD_EVERY periods passed since."""
+        if self.periods // YIELD_EVERY != periods // YIELD_EVERY:
+            await trio.lowlevel.checkpoint()
 
     async def _period(self, stretched: bool) -> tuple[Fired, ...]:
         fired = self._step(stretched)

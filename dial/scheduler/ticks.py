@@ -12,12 +12,10 @@ from collections import defaultdict
 from dataclasses import dataclass
 from typing import NamedTuple, cast
 
-import trio
-
 from dial.errors import DialError
 from dial.parser.script import Run, Script, TBlock, TOn, Watch
 from dial.scheduler.active import ActiveRun, RunPlan
-from dial.scheduler.periods import ABORT_ON, YIELD_EVERY, Observe, Periods, Progress
+from dial.scheduler.periods import ABORT_ON, Observe, Periods, Progress
 from dial.scheduler.records import Records
 from dial.scheduler.signals import StopRequest
 from dial.scheduler.types import (
@@ -151,13 +149,8 @@ class TickLoop(Periods[S]):
             k, t0 = k + 1, self.sim_time
             self.tick += 1
         rest = done - (self.periods - start)
-        self.periods += rest
-        self.clock += rest
-        fired = self._report(report) if report is not None else ()
-        self._snap = None
-        self._raise_pending()
-        if self.periods // YIELD_EVERY != start // YIELD_EVERY:
-            await trio.lowlevel.checkpoint()
+        fired = self._coasted(rest, report)
+        await self._yield_since(start)
         return fired, k, t0, n - rest
 
     def _plan(self, block: TBlock) -> _Plan:

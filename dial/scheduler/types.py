@@ -121,6 +121,11 @@ class RunInfo:
     period: float
     instant: bool = False  # sensed once with zero duration (a sensing run or condition test)
 
+    @property
+    def span(self) -> int:
+        """The run's executing ticks, in control periods (a one-tick run's is one tick)."""
+        return (self.run.exec_end - self.run.start + 1) * self.periods_per_tick
+
 
 PrimitiveFactory = Callable[[RunInfo], "Primitive[S] | Sensor[S]"]
 
