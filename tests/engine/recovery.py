@@ -44,3 +44,12 @@ def check_recovery(
     again = after.index(("start", watched, None))
     assert ("end", watched, "done") in after[again:]  # the retried descent went down
     return summary
+
+
+def without_reactions(script: Path, watch: str, resume: str, tmp_path: Path) -> Path:
+    """A copy of ``script`` with its watches and ``@on`` blocks cut out: from the ``watch``
+    line (its first watched line) up to the comment ``resume`` that follows them."""
+    first, rest = script.read_text().split(watch, 1)
+    bare = tmp_path / f"{script.stem}_without_on.dial"
+    bare.write_text(first + "\n" + rest[rest.index(resume) :])
+    return bare

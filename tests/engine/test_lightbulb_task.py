@@ -13,7 +13,7 @@ import pytest
 import dial
 
 from ..conftest import ROOT
-from .recovery import check_recovery, ended
+from .recovery import check_recovery, ended, without_reactions
 
 SCRIPT = ROOT / "scripts" / "lightbulb.dial"
 # The documented push: the thumb's fingertip pushed 5 N towards the glass for 0.5 s while the
@@ -84,11 +84,7 @@ def test_a_push_on_the_way_down_is_met_by_the_reaction(
 
 
 def test_without_its_reaction_the_same_push_leaves_the_thumb_caught(tmp_path: Path) -> None:
-    text = SCRIPT.read_text()
-    first, rest = text.split("bump_thumb   ~~~~\n", 1)
-    rest = rest[rest.index("/* FEEL FOR THE GLASS") :]  # the watches and both @on removed
-    bare = tmp_path / "lightbulb_without_on.dial"
-    bare.write_text(first + "\n" + rest)
+    bare = without_reactions(SCRIPT, "bump_thumb   ~~~~\n", "/* FEEL FOR THE GLASS", tmp_path)
     result = dial.run(dial.load(bare), disturb=[PUSH])
     assert not result.ok
     assert result.error is not None and "@repeat while ringing" in result.error

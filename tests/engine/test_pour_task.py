@@ -14,7 +14,7 @@ import pytest
 import dial
 
 from ..conftest import ROOT
-from .recovery import check_recovery, ended
+from .recovery import check_recovery, ended, without_reactions
 
 SCRIPT = ROOT / "scripts" / "pour.dial"
 # The documented push: the thumb's fingertip pushed 5 N towards the pitcher for 0.5 s while the
@@ -54,17 +54,9 @@ def test_a_push_on_the_way_down_is_met_by_the_reaction(
     assert summary["success"] == POURED
 
 
-def _without_reaction(tmp_path: Path) -> Path:
-    text = SCRIPT.read_text()
-    first, rest = text.split("bump_thumb  ~~\n", 1)
-    rest = rest[rest.index("/* GRASP, POUR") :]  # the watches and both @on removed
-    bare = tmp_path / "pour_without_on.dial"
-    bare.write_text(first + "\n" + rest)
-    return bare
-
-
 def test_without_its_reaction_the_same_push_spills_the_pour(tmp_path: Path) -> None:
-    result = dial.run(dial.load(_without_reaction(tmp_path)), disturb=[PUSH])
+    bare = without_reactions(SCRIPT, "bump_thumb  ~~\n", "/* GRASP, POUR", tmp_path)
+    result = dial.run(dial.load(bare), disturb=[PUSH])
     assert not result.log.of("monitor")
     assert result.ok is False and result.success["contents_in_cup"] is False, result.details
 
