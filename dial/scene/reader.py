@@ -41,14 +41,8 @@ class Reader:
         self, table: Mapping[str, Any], key: str, required: Iterable[str], optional: Iterable[str]
     ) -> None:
         """Reject missing and unknown keys, listing the valid ones."""
-        required, optional = tuple(required), tuple(optional)
-        valid = ", ".join((*required, *optional))
-        for name in required:
-            if name not in table:
-                raise self.error(key, f"missing key '{name}' (keys: {valid})")
-        for name in table:
-            if name not in required and name not in optional:
-                raise self.error(_join(key, name), f"unknown key; valid keys: {valid}")
+        for name, message in key_problems(table, required, optional):
+            raise self.error(key if name is None else _join(key, name), message)
 
     def string(self, value: Any, key: str) -> str:
         if not isinstance(value, str):
@@ -84,6 +78,22 @@ class Reader:
         if not isinstance(value, list) or not value:
             raise self.error(key, f"expected a non-empty list of strings, got {_kind(value)}")
         return tuple(self.string(v, f"{key}[{i}]") for i, v in enumerate(value))
+
+
+def key_problems(
+    table: Mapping[str, Any], required: Iterable[str], optional: Iterable[str]
+) -> list[tuple[str | None, str]]:
+    """Each missing key (None: the table's own problem) and each unknown key (its name), with
+    a message listing the valid keys: missing ones first, in the order of ``required``."""
+    required, optional = tuple(required), tuple(optional)
+    valid = ", ".join((*required, *optional))
+    missing = [(None, f"missing key '{n}' (keys: {valid})") for n in required if n not in table]
+    unknown = [
+        (name, f"unknown key; valid keys: {valid}")
+        for name in table
+        if name not in required and name not in optional
+    ]
+    return [*missing, *unknown]
 
 
 def _join(key: str, name: str) -> str:
