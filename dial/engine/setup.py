@@ -20,7 +20,7 @@ from dial.geometry import Pose, location_pose, rpy_matrix
 from dial.parser.script import Script
 from dial.primitives import Context
 from dial.scene.of_script import script_world
-from dial.scene.resolve import worlds_dir
+from dial.scene.resolve import bundled_name
 from dial.scene.thread import set_turns
 from dial.scene.world import World
 from dial.scheduler.log import EventLog
@@ -98,10 +98,10 @@ def prepare(
     mujoco.mj_forward(model, data)
     for _ in range(round(SETTLE_S / model.opt.timestep)):
         mujoco.mj_step(model, data)
-    # A bundled world by its file name; another by its absolute path, so that dial replay
-    # finds it from anywhere.
-    bundled = world.path.parent == worlds_dir().resolve()
-    where = world.path.name if bundled else str(world.path)
+    # A bundled world by its name as a file ("pour.toml", "allegro_panda/pour.toml");
+    # another by its absolute path, so that dial replay finds it from anywhere.
+    bundled = bundled_name(world.path)
+    where = f"{bundled}.toml" if bundled else str(world.path)
     log.write("scene", scene=world.name, world=where, perturb=shift, seed=seed)
     robot = MujocoRobot(model, data, disturbances=placed)
     return robot, Context(robot, world, believed, ik)

@@ -5,12 +5,8 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from dial.errors import DialError
-from dial.resources import data_dir
-from dial.robots.profile import FILE, RobotProfile, load_profile
-
-DEFAULT = "utah_hand_puma"  # the robot of a world file that names none
-POSES_FILE = "hand_poses.toml"  # shared hand poses beside the world files, not a scene
+from dial.robots.profile import RobotProfile, load_profile
+from dial.scene.resolve import bundled_name, bundled_robot_names, models_dir
 
 _LOAD_TEXT = {
     "tendon": "tendon tensions (a flexor and an extensor per joint, N)",
@@ -21,29 +17,13 @@ _LOAD_TEXT = {
 
 def bundled_robots() -> tuple[Path, ...]:
     """The bundled robot folders: the default robot first, then by name."""
-    folders = sorted(p.parent for p in data_dir("models").glob(f"*/{FILE}"))
-    return tuple(sorted(folders, key=lambda p: (p.name != DEFAULT, p.name)))
-
-
-def robot_folder(name: str, base: Path | None = None) -> Path:
-    """A robot by bundled name, or a folder (relative to ``base``) holding a robot.toml."""
-    path = Path(name).expanduser()
-    if not path.is_absolute() and base is not None:
-        path = base / path
-    if (path / FILE).is_file():
-        return path.resolve()
-    bundled = {p.name: p for p in bundled_robots()}
-    if name in bundled:
-        return bundled[name]
-    raise DialError(
-        f"unknown robot '{name}': neither a folder with a {FILE} nor a bundled robot; "
-        f"bundled robots: {', '.join(bundled)}"
-    )
+    return tuple(models_dir() / name for name in bundled_robot_names())
 
 
 def scenes(profile: RobotProfile) -> tuple[str, ...]:
-    """The robot's world files, by name."""
-    return tuple(sorted(p.stem for p in profile.worlds.glob("*.toml") if p.name != POSES_FILE))
+    """The robot's scenes: bundled names (as ``@scene`` takes them) or world file names."""
+    names = (bundled_name(p) or p.stem for p in profile.worlds.glob("*.toml"))
+    return tuple(sorted(n for n in names if n != "hand_poses"))
 
 
 def describe(profile: RobotProfile) -> dict[str, Any]:

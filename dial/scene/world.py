@@ -9,7 +9,7 @@ from __future__ import annotations
 import math
 import tomllib
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from difflib import get_close_matches
 from pathlib import Path
 from types import MappingProxyType
@@ -21,12 +21,24 @@ from dial.instructions.types import FINGERS
 from dial.scene.criteria import Criterion, parse_criterion
 from dial.scene.mjcf import body_names
 from dial.scene.reader import Reader, WorldFileError
-from dial.scene.resolve import resolve_scene
+from dial.scene.resolve import (
+    ROBOT_DIR,
+    ROBOT_FILE,
+    bundled_name,
+    bundled_robot_names,
+    models_dir,
+    resolve_scene,
+)
 from dial.scene.valii import NAME, Appro, Drive, Move, Statement, StatementError, parse_statement
 
 JOINTS: tuple[str, ...] = ("abd", "mcp", "pip", "dip")  # joint j of a finger: bit 4*f + j
 MAX_TURNS = 20.0  # a thread's turns before it lets go; more is a typo, not a bulb
 AXES: tuple[str, ...] = ("object", "world")
+
+
+def default_robot() -> Path:
+    """The folder of the robot a world file runs on when it names none."""
+    return (models_dir() / ROBOT_DIR).resolve()
 
 
 @dataclass(frozen=True)
@@ -81,7 +93,9 @@ class Program:
 
 @dataclass(frozen=True)
 class World:
-    """Everything a world file declares. ``objects`` maps aliases to MuJoCo body names."""
+    """Everything a world file declares. ``objects`` maps aliases to MuJoCo body names;
+    ``robot`` is the folder of the robot the scene binds scripts to (``robot = ...``, by
+    default the Utah hand on the PUMA)."""
 
     name: str
     path: Path
@@ -92,6 +106,7 @@ class World:
     programs: Mapping[str, Program]
     criteria: tuple[Criterion, ...]
     thread_turns: float | None = None  # [thread] turns: the model's threads let go after these
+    robot: Path = field(default_factory=default_robot)  # the robot's folder (robot.toml)
 
     def scene_names(self) -> SceneNames:
         """The names the script checker needs."""
@@ -105,7 +120,7 @@ class World:
         )
 
 
-_OPTIONAL_KEYS = ("poses", "locations", "programs", "criteria", "thread")
+_OPTIONAL_KEYS = ("robot", "poses", "locations", "programs", "criteria", "thread")
 
 
 def load_world(path: Path) -> World:
@@ -141,7 +156,7 @@ def load_world(path: Path) -> World:
         for name, value in reader.table(data.get("criteria", {}), "criteria").items()
     )
     return World(
-        name=path.stem,
+        name=bundled_name(path) or path.stem,
         path=path,
         model_path=model_path,
         objects=MappingProxyType(objects),
@@ -150,6 +165,7 @@ def load_world(path: Path) -> World:
         programs=MappingProxyType(programs),
         criteria=criteria,
         thread_turns=_thread_turns(reader, data["thread"]) if "thread" in data else None,
+        robot=_robot(reader, data["robot"]) if "robot" in data else default_robot(),
     )
 
 
@@ -166,7 +182,7 @@ def load_scene_names(scene: str, script_dir: Path) -> SceneNames:
 
 def check_bodies(world: World) -> None:
     """Raise :class:`WorldFileError` if the model is malformed or lacks an object's body."""
-    bodies = body_names(world.model_path)
+    bodies = body_names(world.model_path, world.robot)
     for alias, body in world.objects.items():
         if body not in bodies:
             close = get_close_matches(body, sorted(bodies), n=2)
@@ -258,6 +274,19 @@ def _program(reader: Reader, name: str, value: Any, locations: Mapping[str, Loca
     return Program(name, tuple(statements))
 
 
+def _robot(reader: Reader, value: Any) -> Path:
+    """``robot``: a bundled robot's name, or its folder (made absolute by :func:`_load_merged`)."""
+    text = reader.string(value, "robot")
+    folder = Path(text) if Path(text).is_absolute() else models_dir() / text
+    if (folder / ROBOT_FILE).is_file():
+        return folder.resolve()
+    raise reader.error(
+        "robot",
+        f"no robot '{text}': neither a folder with a {ROBOT_FILE} nor a bundled robot; "
+        f"bundled robots: {', '.join(bundled_robot_names())}",
+    )
+
+
 def _thread_turns(reader: Reader, value: Any) -> float:
     """``[thread] turns``: counter-clockwise turns from screwed tight until the thread lets go."""
     table = reader.table(value, "thread")
@@ -297,6 +326,9 @@ def _load_merged(path: Path, seen: tuple[Path, ...]) -> tuple[dict[str, Any], fr
         for key in ("model", "poses"):
             if isinstance(scene.get(key), str):
                 scene[key] = str((path.parent / scene[key]).resolve())
+    robot = data.get("robot")
+    if isinstance(robot, str) and (path.parent / robot / ROBOT_FILE).is_file():
+        data["robot"] = str((path.parent / robot).resolve())  # a folder, not a bundled name
     if "extends" not in data:
         return data, frozenset({path})
     value = data.pop("extends")

@@ -197,7 +197,7 @@ def _world(tmp_path: Path, body: str) -> Path:
             '[criteria.c]\nkind = "upright"\nobject = "block"\ntilt = 3',
             "criteria.c.tilt: unknown key",
         ),
-        ("[bogus]", "bogus: unknown key; valid keys: scene, objects, poses"),
+        ("[bogus]", "bogus: unknown key; valid keys: scene, objects, robot, poses"),
         ("[thread]\nturns = true", "thread.turns: expected a number, got a boolean (true)"),
         ("[thread]", "thread: missing key 'turns' (keys: turns)"),
         ("[thread]\nturns = 2\npitch = 4", "thread.pitch: unknown key; valid keys: turns"),
