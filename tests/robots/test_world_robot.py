@@ -18,7 +18,8 @@ MODELS = ROOT / "models"
 def world(tmp_path: Path, robot_line: str) -> Path:
     path = tmp_path / "w.toml"
     model = MODELS / "allegro_panda" / "scene_surface.xml"
-    path.write_text(f'{robot_line}\n[scene]\nmodel = "{model}"\n[objects]\nblock = "surface_block"\n')
+    objects = '[objects]\nblock = "surface_block"\n'
+    path.write_text(f'{robot_line}\n[scene]\nmodel = "{model}"\n{objects}')
     return path
 
 
@@ -28,9 +29,10 @@ def test_the_default_robot_is_the_utah_hand_on_the_puma() -> None:
 
 
 def test_a_bundled_robot_by_name(tmp_path: Path) -> None:
-    assert load_world(world(tmp_path, 'robot = "allegro_panda"')).robot == (
-        MODELS / "allegro_panda"
-    ).resolve()
+    assert (
+        load_world(world(tmp_path, 'robot = "allegro_panda"')).robot
+        == (MODELS / "allegro_panda").resolve()
+    )
 
 
 def test_a_robot_folder_relative_to_the_world_file(tmp_path: Path) -> None:
