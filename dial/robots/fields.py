@@ -76,12 +76,20 @@ class Fields:
             raise self.fail(path, f"expected one of {', '.join(choices)}, got '{text}'")
         return text
 
-    def number(self, value: Any, path: Path, positive: bool = False) -> float:
+    def number(
+        self, value: Any, path: Path, positive: bool = False, nonnegative: bool = False
+    ) -> float:
         _present(value)
         if isinstance(value, bool) or not isinstance(value, int | float):
             raise self.fail(path, f"expected a number, got {_kind(value)}")
-        if not math.isfinite(value) or (positive and value <= 0):
-            what = "a positive number" if positive else "a finite number"
+        if not math.isfinite(value) or (positive and value <= 0) or (nonnegative and value < 0):
+            what = (
+                "a positive number"
+                if positive
+                else "a number of 0 or more"
+                if nonnegative
+                else "a finite number"
+            )
             raise self.fail(path, f"expected {what}, got {value}")
         return float(value)
 
@@ -108,12 +116,14 @@ class Fields:
         items = self._list(value, path, n, "whole numbers")
         return tuple(self.integer(v, (*path, i)) for i, v in enumerate(items))
 
-    def per_joint(self, value: Any, path: Path, n: int) -> tuple[float, ...]:
-        """A positive number for every one of ``n`` joints, or one number for all of them."""
+    def per_joint(self, value: Any, path: Path, n: int, zero: bool = False) -> tuple[float, ...]:
+        """A positive number (or 0, if ``zero``) for every one of ``n`` joints, or one number
+        for all of them."""
         if isinstance(value, list):
-            return self.numbers(value, path, n, positive=True)
+            items = self._list(value, path, n, "numbers")
+            return tuple(self.number(v, (*path, i), not zero, zero) for i, v in enumerate(items))
         _present(value)
-        return (self.number(value, path, positive=True),) * n
+        return (self.number(value, path, not zero, zero),) * n
 
     def _list(self, value: Any, path: Path, n: int | None, what: str) -> list[Any]:
         _present(value)

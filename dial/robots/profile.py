@@ -254,7 +254,7 @@ def _arm(f: Fields, arm: Any) -> Arm:
     tool = f.string(arm.get("tool_site"), (*p, "tool_site"))
     home = f.numbers(arm.get("home"), (*p, "home"), n)
     kp = f.per_joint(arm.get("kp"), (*p, "kp"), n)
-    kv = f.per_joint(arm.get("kv"), (*p, "kv"), n)
+    kv = f.per_joint(arm.get("kv"), (*p, "kv"), n, zero=True)
     return Arm(joints, servos, tool, home, kp, kv, _ik(f, arm.get("ik", {}), home))
 
 
@@ -303,7 +303,7 @@ def _hand(f: Fields, hand: Any, fingers: tuple[Finger, ...] | None) -> Hand:
         return Hand(load, lever, (rows, cols), servo)
     n = sum(len(g.joints) for g in fingers or ())
     kp = f.per_joint(hand.get("kp"), (*p, "kp"), n)
-    kv = f.per_joint(hand.get("kv"), (*p, "kv"), n)
+    kv = f.per_joint(hand.get("kv"), (*p, "kv"), n, zero=True)
     return Hand(load, lever, (rows, cols), HandServo(kp=kp, kv=kv))
 
 
