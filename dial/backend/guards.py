@@ -15,7 +15,8 @@ from dataclasses import dataclass, field
 import mujoco
 import numpy as np
 
-from dial.backend.model import RobotIndex, tendon_tensions
+from dial.backend.index import RobotIndex
+from dial.backend.model import hand_angles, tendon_tensions
 from dial.robot.contact import POSITION_LEVER
 from dial.robot.snapshot import FloatArray, Trip
 
@@ -43,23 +44,32 @@ class Readings:
     robot: :meth:`at_step` starts each step afresh."""
 
     __slots__ = (
-        "_data", "_diff", "_dropped", "_index", "_q", "_tactile", "_target",
-        "_tensions", "_tips",
+        "_data", "_diff", "_dropped", "_index", "_joints", "_lever", "_q", "_tactile",
+        "_target", "_tensions", "_tips",
     )  # fmt: skip
 
     def __init__(self, data: mujoco.MjData, index: RobotIndex, tactile_adr: Sequence[int]) -> None:
         self._data, self._index = data, index
         # Views into sensordata stay valid for the data's life: slicing once saves a lot.
-        self._tactile = [data.sensordata[a : a + 256] for a in tactile_adr]
+        n = index.profile.hand.taxels[0] * index.profile.hand.taxels[1]
+        self._tactile = [data.sensordata[a : a + n] if a >= 0 else None for a in tactile_adr]
         self._tips: list[float | None] | None = None  # this step's deepest taxel per finger
-        adr = index.tension_sensors
-        first = int(adr[0])
-        # The 32 tensions as a view where they run in order (flexor, extensor per joint).
-        in_order = np.array_equal(adr, np.arange(first, first + len(adr)))
+        adr = index.load_sensors
+        first = int(adr[0]) if len(adr) else -1
+        # The load readings as a view where they run in order (a tendon hand: flexor,
+        # extensor per joint).
+        in_order = first >= 0 and np.array_equal(adr, np.arange(first, first + len(adr)))
         self._tensions = data.sensordata[first : first + len(adr)] if in_order else None
+        # Each finger's joints: (mask bit, index of the joint among the hand's joints).
+        bits = index.hand_bits.tolist()
+        self._joints: list[list[tuple[int, int]]] = [
+            [(b, i) for i, b in enumerate(bits) if b // 4 == f]
+            for f in range(len(index.profile.fingers))
+        ]
+        self._lever = index.lever  # a joint torque (N m) over this is its load in N
         self._target: FloatArray = np.zeros(16)
         self._dropped: frozenset[tuple[str, int]] = frozenset()
-        self._diff: list[float] | None = None  # this step's 32 tensions (flexor, extensor)
+        self._diff: list[float] | None = None  # this step's load readings, as Python floats
         self._q: FloatArray | None = None
 
     def at_step(self, target: FloatArray, dropped: frozenset[tuple[str, int]]) -> Readings:
@@ -79,19 +89,22 @@ class Readings:
             tip = tips[f]
             if tip is None:
                 row = self._tactile[f]
-                tip = tips[f] = float(row.item(row.argmax()))
+                tip = tips[f] = 0.0 if row is None else float(row.item(row.argmax()))
             return tip
         if kind == "force":
-            # The largest change of a finger's four differentials since the guard was armed,
-            # in Python floats: the tensions are read once per step, whatever the guards.
+            # The largest change of a finger's joint loads since the guard was armed, in
+            # Python floats: the loads are read once per step, whatever the guards.
             if self._diff is None:
                 view = self._tensions
-                tensions = view if view is not None else tendon_tensions(self._data, self._index)
-                self._diff = tensions.tolist()
+                raw = view if view is not None else tendon_tensions(self._data, self._index)
+                self._diff = raw.tolist()
             t: list[float] = self._diff
-            return max(abs(t[2 * k] - t[2 * k + 1] - baseline[k]) for k in range(4 * f, 4 * f + 4))
+            if self._index.tendons:
+                return max(abs(t[2 * i] - t[2 * i + 1] - baseline[k]) for k, i in self._joints[f])
+            lever = self._lever
+            return max(abs(t[i] / lever - baseline[k]) for k, i in self._joints[f])
         if self._q is None:
-            self._q = self._data.qpos[self._index.hand_qpos]
+            self._q = hand_angles(self._data, self._index)
         joints = slice(4 * f, 4 * f + 4)
         return float(np.linalg.norm(self._target[joints] - self._q[joints])) * POSITION_LEVER
 

@@ -1,8 +1,10 @@
 """Inverse kinematics with mink on a robot-only copy of the model.
 
-The IK model holds only the arm and hand (no scene objects), so its QP stays at
-22 velocities whatever the scene holds. Solutions are warm-started from the last
-one: a straight-line move solves one waypoint per control period.
+The IK model holds only the arm and hand (no scene objects), so its QP stays at the robot's
+velocities (22 for the Utah hand on the PUMA) whatever the scene holds. Solutions are
+warm-started from the last one: a straight-line move solves one waypoint per control
+period. The tool site, the task weights, a posture task for a redundant arm and the retry
+seeds are the robot profile's (``[arm.ik]`` of its ``robot.toml``).
 """
 
 from __future__ import annotations
@@ -11,10 +13,12 @@ import mink
 import mujoco
 import numpy as np
 
-from dial.backend.model import RobotIndex, load_model
+from dial.backend.index import RobotIndex
+from dial.backend.model import default_profile, load_model
 from dial.errors import DialError
 from dial.robot.memo import SOLUTIONS, memo_key
 from dial.robot.snapshot import FloatArray
+from dial.robots.profile import RobotProfile
 
 SOLVER = "daqp"
 DT = 0.01  # s: the differential step of one solve
@@ -29,27 +33,63 @@ class IKError(DialError):
 
 
 class _Base:
-    def __init__(self, model: mujoco.MjModel | None = None) -> None:
-        """On the robot-only model, compiled, or ``model`` (one; for several solvers)."""
-        self.model = load_model() if model is None else model
-        self.index = RobotIndex.from_model(self.model)
+    def __init__(
+        self, model: mujoco.MjModel | None = None, profile: RobotProfile | None = None
+    ) -> None:
+        """On the robot-only model of ``profile`` (the default robot when None), compiled, or
+        ``model`` (one; for several solvers)."""
+        profile = default_profile() if profile is None else profile
+        self.model = load_model(profile=profile) if model is None else model
+        self.index = RobotIndex.from_model(self.model, profile)
         self.config = mink.Configuration(self.model)
+        # Joints at 0 where 0 is out of their range (the Allegro's thumb base) start at the
+        # nearest limit: a configuration outside the limits has no feasible step.
+        limited = self.model.jnt_limited.astype(bool)
+        q = self.config.q.copy()
+        adr, lo, hi = (
+            self.model.jnt_qposadr[limited],
+            self.model.jnt_range[limited, 0],
+            self.model.jnt_range[limited, 1],
+        )
+        q[adr] = np.clip(q[adr], lo, hi)
+        self.config.update(q)
         self.limits = [mink.ConfigurationLimit(self.model)]
+        self.memo = profile.name  # solutions are memoised per robot
 
     def _site(self, name: str) -> int:
         return int(mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_SITE, name))
 
 
 class ArmIK(_Base):
-    """Tool-frame (``hand_palm``) IK over the six PUMA joints."""
+    """Tool-frame IK over the arm's joints (with a posture task for the spare freedom of an
+    arm of more than six)."""
 
     MEMO = "arm"  # the memo's name for this solver's results
 
-    def __init__(self, model: mujoco.MjModel | None = None) -> None:
-        super().__init__(model)
-        self.task = mink.FrameTask("hand_palm", "site", position_cost=1.0, orientation_cost=0.2)
+    def __init__(
+        self, model: mujoco.MjModel | None = None, profile: RobotProfile | None = None
+    ) -> None:
+        super().__init__(model, profile)
+        self.MEMO = f"arm:{self.memo}"  # per robot: two arms may share a configuration
+        settings = self.index.profile.arm.ik
+        self.task = mink.FrameTask(
+            self.index.profile.arm.tool_site,
+            "site",
+            position_cost=settings.position_cost,
+            orientation_cost=settings.orientation_cost,
+        )
+        self.tasks: list[mink.Task] = [self.task]
+        if settings.posture_cost > 0:
+            cost = np.zeros(self.model.nv)
+            cost[self.index.arm_dof] = settings.posture_cost
+            posture = mink.PostureTask(self.model, cost=cost)
+            target = self.config.q.copy()
+            target[self.index.arm_qpos] = settings.posture
+            posture.set_target(target)
+            self.tasks.append(posture)
         hand = [int(d) for d in self.index.hand_dof]
         self.constraints = [mink.DofFreezingTask(self.model, dof_indices=hand)]
+        self.seeds = tuple(np.array(s, dtype=np.float64) for s in settings.seeds)
 
     def fk(self, arm_q: FloatArray) -> tuple[FloatArray, FloatArray]:
         """Tool position (3,) and rotation (3, 3) at ``arm_q``."""
@@ -74,7 +114,7 @@ class ArmIK(_Base):
                 break
             vel = mink.solve_ik(
                 self.config,
-                [self.task],
+                self.tasks,
                 DT,
                 SOLVER,
                 damping=DAMPING,
@@ -112,7 +152,7 @@ class ArmIK(_Base):
         closest = known if isinstance(known, tuple) else (np.inf, np.inf)
         if isinstance(known, np.ndarray):
             return known.copy()
-        for offset in _SEEDS if known is None else ():
+        for offset in self.seeds if known is None else ():
             self._set(start + offset)
             perr, rerr = self._iterate(pos, rot, SOLVE_ITERATIONS)
             if perr <= 2e-3 and rerr <= 1e-2:
@@ -127,34 +167,22 @@ class ArmIK(_Base):
         )
 
 
-# Start offsets for ArmIK.solve: as given, then wrist (joints 4 and 6) and elbow variations.
-_SEEDS: tuple[FloatArray, ...] = tuple(
-    np.array(o, dtype=np.float64)
-    for o in (
-        (0, 0, 0, 0, 0, 0),
-        (0, 0, 0, np.pi / 2, 0, -np.pi / 2),
-        (0, 0, 0, -np.pi / 2, 0, np.pi / 2),
-        (0, 0, 0, 0, 0, np.pi),
-        (0, 0, 0, 0, 0, -np.pi),
-        (0, -0.5, 0.5, 0, 0.5, 0),
-        (0, 0.5, -0.5, 0, -0.5, 0),
-    )
-)
-
-
 class FingerIK(_Base):
-    """Fingertip-position IK over one finger's four joints, the rest of the robot frozen."""
+    """Fingertip-position IK over one finger's joints, the rest of the robot frozen."""
 
-    def __init__(self, model: mujoco.MjModel | None = None) -> None:
-        super().__init__(model)
+    def __init__(
+        self, model: mujoco.MjModel | None = None, profile: RobotProfile | None = None
+    ) -> None:
+        super().__init__(model, profile)
         ix = self.index
         self.tasks = [
-            mink.FrameTask(f"hand_{f}_tip", "site", position_cost=1.0, orientation_cost=0.0)
-            for f in ("index", "middle", "ring", "thumb")
+            mink.FrameTask(f.tip_site, "site", position_cost=1.0, orientation_cost=0.0)
+            for f in ix.profile.fingers
         ]
         self.constraints = []
-        for f in range(4):
-            free = {int(d) for d in ix.hand_dof[4 * f : 4 * f + 4]}
+        bits = ix.hand_bits.tolist()
+        for f in range(len(ix.profile.fingers)):
+            free = {int(ix.hand_dof[i]) for i, b in enumerate(bits) if b // 4 == f}
             frozen = [d for d in range(self.model.nv) if d not in free]
             self.constraints.append(mink.DofFreezingTask(self.model, dof_indices=frozen))
 
@@ -166,7 +194,7 @@ class FingerIK(_Base):
     def _set(self, arm_q: FloatArray, hand_q: FloatArray) -> None:
         q = self.config.q.copy()
         q[self.index.arm_qpos] = arm_q
-        q[self.index.hand_qpos] = hand_q
+        q[self.index.hand_qpos] = hand_q[self.index.hand_bits]
         self.config.update(q)
 
     def track(
@@ -178,7 +206,7 @@ class FingerIK(_Base):
         iterations: int = 2,
     ) -> FloatArray:
         """Steps from ``hand_q`` moving the fingertip toward ``tip`` (world, m); returns (16,)."""
-        key = memo_key("finger-track", finger, tip, arm_q, hand_q, iterations)
+        key = memo_key(f"finger-track-{self.memo}", finger, tip, arm_q, hand_q, iterations)
         known = SOLUTIONS.get(key)
         if isinstance(known, np.ndarray):
             return known.copy()
@@ -204,6 +232,7 @@ class FingerIK(_Base):
                 constraints=[self.constraints[finger]],
             )
             self.config.integrate_inplace(vel, DT)
-        q: FloatArray = self.config.q[self.index.hand_qpos].copy()
+        q: FloatArray = np.asarray(hand_q, dtype=np.float64).copy()
+        q[self.index.hand_bits] = self.config.q[self.index.hand_qpos]
         SOLUTIONS.put(key, q.copy())
         return q

@@ -13,7 +13,6 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
-from dial.instructions.types import FINGERS
 from dial.robot.snapshot import FloatArray
 
 
@@ -29,20 +28,15 @@ def tactile_point(depths: FloatArray, taxels: FloatArray) -> FloatArray | None:
     return point
 
 
-def finger_bodies(model: mujoco.MjModel, finger: int) -> frozenset[int]:
-    """Ids of a finger's bodies: knuckle, proximal, medial and distal."""
-    prefix = f"hand_{FINGERS[finger]}_"
-    return frozenset(b for b in range(model.nbody) if model.body(b).name.startswith(prefix))
-
-
 def link_point(
-    model: mujoco.MjModel, data: mujoco.MjData, bodies: frozenset[int]
+    model: mujoco.MjModel, data: mujoco.MjData, bodies: frozenset[int], robot_root: int
 ) -> FloatArray | None:
     """The deepest contact point (3,) between the ``bodies`` and anything outside the robot
     (the first of equally deep ones, in MuJoCo's contact order).
 
     None when the finger touches nothing but the robot (or nothing at all). The contacts are
-    read as arrays: a scene full of balls has a hundred and more of them."""
+    read as arrays: a scene full of balls has a hundred and more of them. ``robot_root``: the
+    root body of the robot's tree (its arm's base, which carries the hand)."""
     n = data.ncon
     if n == 0:
         return None
@@ -53,14 +47,8 @@ def link_point(
     in1, in2 = np.isin(b1, finger), np.isin(b2, finger)
     other = np.where(in1, b2, b1)
     # One side is the finger (not both: the finger touching itself), the other not the robot.
-    hits = np.flatnonzero((in1 != in2) & (model.body_rootid[other] != _robot_root(model)))
+    hits = np.flatnonzero((in1 != in2) & (model.body_rootid[other] != robot_root))
     if len(hits) == 0:
         return None
     deepest = hits[np.argmin(contacts.dist[:n][hits])]
     return np.array(contacts.pos[deepest], dtype=np.float64)
-
-
-def _robot_root(model: mujoco.MjModel) -> int:
-    """The root body of the robot's tree (the PUMA's base, which carries the hand)."""
-    palm = int(mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, "hand_palm"))
-    return int(model.body_rootid[model.site_bodyid[palm]])

@@ -14,7 +14,14 @@ import numpy as np
 from dial.backend.disturb import Disturbances
 from dial.backend.driver import MujocoRobot
 from dial.backend.ik import ArmIK, FingerIK
-from dial.backend.model import ARM_HOME, RobotIndex, hand_ctrl, load_model
+from dial.backend.model import (
+    RobotIndex,
+    hand_actuators,
+    hand_angles,
+    hand_ctrl,
+    load_model,
+    profile_at,
+)
 from dial.disturb import Disturbance
 from dial.geometry import Pose, location_pose, rpy_matrix
 from dial.parser.script import Script
@@ -65,6 +72,15 @@ def perturb(model: mujoco.MjModel, world: World, mm: float, seed: int) -> list[f
     return [float(x) for x in shift]
 
 
+def rest_hand(model: mujoco.MjModel, data: mujoco.MjData, index: RobotIndex) -> None:
+    """The hand straight, each joint at 0 or its nearest limit (a joint whose range leaves
+    out 0: the Allegro's thumb base), its servos holding there."""
+    joints = model.dof_jntid[index.hand_dof]
+    lo, hi = model.jnt_range[joints].T
+    data.qpos[index.hand_qpos] = np.clip(data.qpos[index.hand_qpos], lo, hi)
+    data.ctrl[hand_actuators(index)] = hand_ctrl(hand_angles(data, index), index)
+
+
 def prepare(
     script: Script,
     log: EventLog,
@@ -74,10 +90,11 @@ def prepare(
 ) -> tuple[MujocoRobot, Context]:
     """Load the scene, place the robot at home, perturb, settle; log the ``scene`` record."""
     world = script_world(script)
-    model = load_model(world.model_path)
+    profile = profile_at(world.robot)
+    model = load_model(world.model_path, profile)
     set_turns(model, world)
     placed = Disturbances.on(model, disturbances)  # an unknown body fails before anything moves
-    index = RobotIndex.from_model(model)
+    index = RobotIndex.from_model(model, profile)
     unmoved = mujoco.MjData(model)
     mujoco.mj_forward(model, unmoved)
     believed: dict[str, Pose] = {
@@ -86,15 +103,15 @@ def prepare(
     }
     shift = perturb(model, world, perturb_mm, seed)
     data = mujoco.MjData(model)
-    ik = ArmIK()
+    ik = ArmIK(profile=profile)
     if "home" in world.locations:
         pos, rot = location_pose(world, believed, "home")
     else:
         pos, rot = np.array(START[0]), rpy_matrix(START[1])
-    home = ik.solve(pos, rot, np.array(ARM_HOME), "the start pose (location 'home')")
+    home = ik.solve(pos, rot, np.array(profile.arm.home), "the start pose (location 'home')")
     data.qpos[index.arm_qpos] = home
     data.ctrl[index.arm_actuators] = home
-    data.ctrl[index.tendon_actuators] = hand_ctrl(data.qpos[index.hand_qpos])
+    rest_hand(model, data, index)
     mujoco.mj_forward(model, data)
     for _ in range(round(SETTLE_S / model.opt.timestep)):
         mujoco.mj_step(model, data)
@@ -103,5 +120,5 @@ def prepare(
     bundled = bundled_name(world.path)
     where = f"{bundled}.toml" if bundled else str(world.path)
     log.write("scene", scene=world.name, world=where, perturb=shift, seed=seed)
-    robot = MujocoRobot(model, data, disturbances=placed)
-    return robot, Context(robot, robot.view, world, believed, ik, FingerIK())
+    robot = MujocoRobot(model, data, disturbances=placed, profile=profile)
+    return robot, Context(robot, robot.view, world, believed, ik, FingerIK(profile=profile))

@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from dial.instructions.types import FINGERS
 from dial.parser.script import EventDef
 from dial.preview.motions import PreviewPuma
 from dial.preview.scene import Scene
@@ -46,7 +45,7 @@ def finished(scene: Scene, prim: Primitive[Snapshot]) -> list[str]:
     if off <= TIP_TOL:
         return []
     return [
-        f"the {_finger(prim.finger)} fingertip stops {off * 1000:.1f} mm short of its goal "
+        f"the {scene.fingers[prim.finger]} fingertip stops {off * 1000:.1f} mm short of its goal "
         "(a joint limit, or out of the finger's reach)"
     ]
 
@@ -89,11 +88,7 @@ def _pose(scene: Scene, prim: HandPose, name: str) -> list[str]:
             continue
         side, limit = ("lower", lo) if angle < lo else ("upper", hi)
         out.append(
-            f"hand pose '{name}' sets the {_finger(k // 4)} {JOINTS[k % 4]} joint to "
+            f"hand pose '{name}' sets the {scene.fingers[k // 4]} {JOINTS[k % 4]} joint to "
             f"{np.degrees(angle):.1f} deg, beyond its {side} limit {np.degrees(limit):.1f} deg"
         )
     return out
-
-
-def _finger(f: int) -> str:
-    return FINGERS[f]

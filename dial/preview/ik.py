@@ -27,6 +27,7 @@ from dial.backend.ik import (
     FingerIK,
 )
 from dial.robot.snapshot import FloatArray
+from dial.robots.profile import RobotProfile
 
 LEAN_ITERATIONS = 30  # per start of LeanArmIK.solve, before it leaves one to mink
 
@@ -47,8 +48,11 @@ class LeanArmIK(ArmIK):
 
     MEMO = "lean-arm"
 
-    def __init__(self, model: mujoco.MjModel | None = None) -> None:
-        super().__init__(model)
+    def __init__(
+        self, model: mujoco.MjModel | None = None, profile: RobotProfile | None = None
+    ) -> None:
+        super().__init__(model, profile)
+        self.MEMO = f"lean-arm:{self.memo}"
         limit, task, qpos = self.limits[0], self.task, self.index.arm_qpos
         self._qpos, self._dof = _as_slice(qpos), _as_slice(self.index.arm_dof)
         self._reach = (limit.gain * limit.lower[qpos], limit.gain * limit.upper[qpos], limit.gain)
@@ -81,6 +85,8 @@ class LeanArmIK(ArmIK):
             self.config.update()
 
     def _iterate(self, pos: FloatArray, rot: FloatArray, iterations: int) -> tuple[float, float]:
+        if len(self.tasks) > 1:  # a posture task (a redundant arm): mink's QP as it is
+            return super()._iterate(pos, rot, iterations)
         task, config = self.task, self.config
         target = np.empty(7)
         mujoco.mju_mat2Quat(target[:4], np.ascontiguousarray(rot, dtype=np.float64).ravel())
@@ -175,13 +181,16 @@ class FingerIKOnDemand(FingerIK):
     """The fingers' IK, on a copy of the arm's model, set up when a run first uses it (most
     scripts never do)."""
 
-    def __init__(self, model: mujoco.MjModel) -> None:  # FingerIK's own waits for _ready
+    def __init__(  # FingerIK's own waits for _ready
+        self, model: mujoco.MjModel, profile: RobotProfile | None = None
+    ) -> None:
         self._pending: mujoco.MjModel | None = model
+        self._profile = profile
 
     def _ready(self) -> None:
         if self._pending is not None:
             model, self._pending = self._pending, None
-            super().__init__(copy.copy(model))
+            super().__init__(copy.copy(model), self._profile)
 
     # The two ways in (their arguments as FingerIK's, which callers are checked against).
     def tip(self, *args: Any, **kwargs: Any) -> FloatArray:

@@ -21,7 +21,6 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from dial.backend.ik import IKError
-from dial.instructions.types import FINGERS
 from dial.parser.script import EventDef
 from dial.preview.places import Places
 from dial.preview.scene import HAND, Scene, State, finger_group
@@ -123,7 +122,7 @@ def guarded(scene: Scene, event: EventDef, check: Check) -> Report:
             _bisect(scene, before, reach, s, s_next, groups)
             return Report(Outcome.DONE)
         if lag > LAG:
-            who = "the tool" if finger is None else f"the {FINGERS[finger]} fingertip"
+            who = "the tool" if finger is None else f"the {scene.fingers[finger]} fingertip"
             return Report(
                 Outcome.MISSED,
                 [

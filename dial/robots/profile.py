@@ -21,7 +21,8 @@ from dial.robots.locate import locate, nearest
 
 FILE = "robot.toml"
 LOADS: tuple[str, ...] = ("tendon", "actuator", "joint")
-MAX_FINGERS = 4  # the masks have 16 bits: bit 4 f + j for finger f, joint j
+# The fingers, in mask order: the masks have 16 bits, bit 4 f + j for finger f, joint j.
+FINGER_NAMES = ("index", "middle", "ring", "thumb")
 MAX_JOINTS = 4
 MIN_ARM_JOINTS = 6  # a tool position and orientation
 Load = Literal["tendon", "actuator", "joint"]
@@ -41,6 +42,7 @@ class IKSettings:
 
 @dataclass(frozen=True)
 class Arm:
+    name: str  # what messages call it: "PUMA joint 3 is beyond its limit"
     joints: tuple[str, ...]  # in order: VAL-II's DRIVE J turns the J-th
     servos: tuple[str, ...]  # their position actuators, same order
     tool_site: str
@@ -245,7 +247,8 @@ def _top(f: Fields, path: Path, data: dict[str, Any]) -> tuple[str, str, Path, P
 
 def _arm(f: Fields, arm: Any) -> Arm:
     p = ("arm",)
-    f.keys(arm, p, ["joints", "servos", "tool_site", "home", "kp", "kv"], ["ik"])
+    f.keys(arm, p, ["name", "joints", "servos", "tool_site", "home", "kp", "kv"], ["ik"])
+    name = f.string(arm.get("name"), (*p, "name"))
     joints = f.names(arm.get("joints"), (*p, "joints"))
     n = len(joints)
     if n < MIN_ARM_JOINTS:
@@ -255,7 +258,7 @@ def _arm(f: Fields, arm: Any) -> Arm:
     home = f.numbers(arm.get("home"), (*p, "home"), n)
     kp = f.per_joint(arm.get("kp"), (*p, "kp"), n)
     kv = f.per_joint(arm.get("kv"), (*p, "kv"), n, zero=True)
-    return Arm(joints, servos, tool, home, kp, kv, _ik(f, arm.get("ik", {}), home))
+    return Arm(name, joints, servos, tool, home, kp, kv, _ik(f, arm.get("ik", {}), home))
 
 
 def _ik(f: Fields, ik: Any, home: tuple[float, ...]) -> IKSettings:
@@ -309,19 +312,23 @@ def _hand(f: Fields, hand: Any, fingers: tuple[Finger, ...] | None) -> Hand:
 
 def _fingers(f: Fields, data: dict[str, Any]) -> tuple[Finger, ...]:
     tables = data.get("fingers")
-    if not isinstance(tables, list) or not tables or not all(isinstance(t, dict) for t in tables):
-        raise f.fail(("fingers",), "expected [[fingers]] tables, one per finger")
-    if len(tables) > MAX_FINGERS:
-        raise f.fail(("fingers", MAX_FINGERS), f"at most {MAX_FINGERS} fingers (16-bit masks)")
+    valid = ", ".join(FINGER_NAMES)
+    if not isinstance(tables, list) or not all(isinstance(t, dict) for t in tables):
+        raise f.fail(("fingers",), f"expected [[fingers]] tables, one per finger: {valid}")
+    if len(tables) != len(FINGER_NAMES):
+        where = ("fingers", min(len(tables), len(FINGER_NAMES)))
+        raise f.fail(where, f"expected {len(FINGER_NAMES)} fingers, {valid}; got {len(tables)}")
     fingers: list[Finger] = []
     for i, table in enumerate(tables):
         p = ("fingers", i)
         optional = ["tactile", "servos", "flexors", "extensors"]
         f.keys(table, p, ["name", "joints", "tip_site"], optional)
         name = f.string(table.get("name"), (*p, "name"))
-        if not name.isidentifier() or name in (g.name for g in fingers):
+        if name != FINGER_NAMES[i]:
             raise f.fail(
-                (*p, "name"), f"expected a new name made of letters, digits and _, got '{name}'"
+                (*p, "name"),
+                f"expected '{FINGER_NAMES[i]}' (the fingers are {valid}, in "
+                f"this order: finger f holds mask bits 4 f to 4 f + 3), got '{name}'",
             )
         joints = f.names(table.get("joints"), (*p, "joints"))
         if len(joints) > MAX_JOINTS:

@@ -166,7 +166,7 @@ def _world(tmp_path: Path, body: str) -> Path:
             '[programs]\np = "JUMP 3"',
             "programs.p line 1: unknown command 'JUMP'; valid commands: MOVE",
         ),
-        ('[programs]\np = "DRIVE 7 10"', "expected a PUMA joint number from 1 to 6, got '7'"),
+        ('[programs]\np = "DRIVE 7 10"', "the PUMA has joints 1 to 6, not 7"),
         ('[programs]\np = "DEPART 5"', "distance 5 is out of range: expected -1 m to 1 m"),
         ('[programs]\np = "DEPART 3N"', "unit 'N' is not a length unit"),
         ('[programs]\np = "; nothing"', "programs.p: a program needs at least one statement"),
