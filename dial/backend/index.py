@@ -17,7 +17,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from dial.errors import DialError
-from dial.robots.profile import RobotProfile
+from dial.robots.profile import RobotProfile, default_profile
 
 IntArray = NDArray[np.intp]
 FloatArray = NDArray[np.float64]
@@ -112,8 +112,6 @@ class RobotIndex:
         """Look up the profile's names (the default robot's when None); raise
         :class:`ModelError` naming the parts the model lacks."""
         if profile is None:
-            from dial.backend.model import default_profile
-
             profile = default_profile()
         joint, actuator, site = (
             mujoco.mjtObj.mjOBJ_JOINT,

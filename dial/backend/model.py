@@ -23,7 +23,7 @@ from dial.backend.index import HAND_BITS, FloatArray, IntArray, ModelError, Robo
 from dial.errors import DialError
 from dial.resources import data_dir
 from dial.robot.view import FingerView, RobotView
-from dial.robots.profile import RobotProfile, load_profile
+from dial.robots.profile import RobotProfile, default_profile, load_profile
 
 __all__ = [
     "ARM_HOME",
@@ -50,12 +50,6 @@ TAXEL_SHAPE = (16, 16)
 # Arm configuration (rad) of the default robot with the palm 0.45 m above the floor, 0.55 m in
 # front of the base, facing down (tool z = -world z): its profile's home.
 ARM_HOME = (0.0, 0.7, -3.26, 0.0, -0.58, 0.0)
-
-
-@functools.cache
-def default_profile() -> RobotProfile:
-    """The default robot's profile (``models/utah_hand_puma/robot.toml``)."""
-    return load_profile(ROBOT_DIR)
 
 
 @functools.cache

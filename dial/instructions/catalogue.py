@@ -12,7 +12,6 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Literal
 
-from dial.instructions.limits import drive_problem
 from dial.instructions.scene_names import SceneNames
 from dial.instructions.types import (
     ALL_JOINTS,
@@ -126,14 +125,6 @@ def _guarded(args: Args, scene: SceneNames | None) -> frozenset[str]:
     return _arm(args, scene) if args.get("finger") is None else _finger(args, scene)
 
 
-def _check_puma(args: Args) -> str | None:
-    if args.get("verb") != "drive":
-        return None
-    joint, angle = args["joint"], args["angle"]
-    assert isinstance(joint, int) and isinstance(angle, float)
-    return drive_problem(joint, angle)
-
-
 def _check_guarded(args: Args) -> str | None:
     if all(args[k] == 0.0 for k in ("dx", "dy", "dz")):
         return "guarded_move needs a nonzero direction DX DY DZ"
@@ -192,7 +183,9 @@ _PUMA_VERBS: dict[str, tuple[ParamSpec, ...]] = {
     ),
     "depart": (ParamSpec("distance", Quantity("length", "m", -1.0, 1.0), doc="back along tool z"),),
     "drive": (
-        ParamSpec("joint", Integer(1, 6)),
+        ParamSpec(
+            "joint", Integer(1, 9), doc="the arm's joint (1-6 on the PUMA, 1-7 on the Panda)"
+        ),
         ParamSpec(
             "angle", Quantity("angle", "deg", -6.2832, 6.2832), doc="degrees unless suffixed"
         ),
@@ -236,7 +229,6 @@ INSTRUCTIONS: dict[str, Instruction] = {
             '| "drive J DEG"',
             "Run a VAL-II command or stored program, time-scaled to the run's span.",
             verbs=_PUMA_VERBS,
-            validate=_check_puma,
             primitive="PumaCommand",
         ),
         Instruction(

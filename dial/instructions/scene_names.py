@@ -10,8 +10,12 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from dial.errors import DialError
+
+if TYPE_CHECKING:
+    from dial.robots.facts import RobotFacts
 
 
 @dataclass(frozen=True)
@@ -20,7 +24,8 @@ class SceneNames:
 
     ``poses`` maps each named hand pose to the 16-bit joint mask it sets
     (bit ``4*f + j``; a pose that sets every joint has mask ``0xFFFF``). ``anchored``: the
-    locations that are relative to an object; ``objects``: the object aliases.
+    locations that are relative to an object; ``objects``: the object aliases; ``robot``:
+    what the scene's robot has (None: the default robot).
     """
 
     name: str
@@ -29,6 +34,7 @@ class SceneNames:
     programs: frozenset[str] = frozenset()
     objects: frozenset[str] = frozenset()
     anchored: frozenset[str] = frozenset()
+    robot: RobotFacts | None = None
 
 
 class SceneNotFoundError(DialError, LookupError):

@@ -17,6 +17,7 @@ from pathlib import Path
 
 from dial.errors import Diagnostic, ScriptError, Span
 from dial.instructions.catalogue import INSTRUCTIONS, Instruction
+from dial.instructions.robot_checks import robot_problems
 from dial.instructions.scene_names import SceneLoader, SceneNames, SceneNotFoundError
 from dial.instructions.types import EFFECTORS, Name, Names
 from dial.parser.ast import Call, Condition, Definition, ExecLine, Program
@@ -24,6 +25,7 @@ from dial.parser.bind import bind
 from dial.parser.compile import compile_body, diagram_events
 from dial.parser.parse import parse_partial
 from dial.parser.script import EventDef, Script
+from dial.robots.facts import default_facts
 
 # The instructions whose condition holds or not at each moment, so that a monitor can sense
 # it every control period: the contact conditions (DESIGN 2.7).
@@ -156,6 +158,9 @@ class _Checker:
         if self.scene is not None and not self.scene_names(d.event, instr, bound.args, bound.spans):
             self.broken.add(d.event)
             return
+        if not self.robot_names(d, instr, bound.args, bound.spans):
+            self.broken.add(d.event)
+            return
         effectors = instr.effectors(bound.args, self.scene)
         self.events[d.event] = EventDef(d.event, instr, bound.args, effectors, d)
 
@@ -177,6 +182,21 @@ class _Checker:
                 ok = False
                 self.error(spans[spec.name], self.unknown(event, spec.type, name, known))
         return ok
+
+    def robot_names(
+        self,
+        d: Definition,
+        instr: Instruction,
+        args: Mapping[str, object],
+        spans: Mapping[str, Span],
+    ) -> bool:
+        """What the event asks of the scene's robot (the default robot without a scene)."""
+        robot = self.scene.robot if self.scene is not None else None
+        problems = robot_problems(instr.name, args, robot or default_facts())
+        for param, message in problems:
+            span = spans.get(param, d.instruction_span) if param else d.instruction_span
+            self.error(span, f"event '{d.event}': {message}")
+        return not problems
 
     def known(self, kind: Name | Names) -> list[str]:
         """The scene's names that a parameter of this type may take."""

@@ -16,7 +16,8 @@ from pathlib import Path
 from types import MappingProxyType
 
 from dial.errors import DialError
-from dial.robots.profile import FINGER_NAMES, RobotProfile, load_profile
+from dial.resources import data_dir
+from dial.robots.profile import DEFAULT_ROBOT, FINGER_NAMES, RobotProfile, load_profile
 from dial.robots.ranges import Range, joint_ranges
 
 JOINT_KINDS = ("abd", "mcp", "pip", "dip")  # joint j of a finger, as world files name it
@@ -77,3 +78,8 @@ def facts_of(profile: RobotProfile) -> RobotFacts:
 def robot_facts(folder: Path) -> RobotFacts:
     """The facts of the robot in ``folder`` (read once per process)."""
     return facts_of(load_profile(folder))
+
+
+def default_facts() -> RobotFacts:
+    """The facts of the default robot (the robot of a script checked without a scene)."""
+    return robot_facts((data_dir("models") / DEFAULT_ROBOT).resolve())

@@ -12,7 +12,6 @@ from dataclasses import dataclass
 from typing import Any
 
 from dial.robots.locate import Path
-from dial.scene.reader import key_problems
 
 
 @dataclass(frozen=True)
@@ -132,6 +131,22 @@ class Fields:
         if n is not None and len(value) != n:
             raise self.fail(path, f"expected {n} {what}, got {len(value)}")
         return value
+
+
+def key_problems(
+    table: Mapping[str, Any], required: Iterable[str], optional: Iterable[str]
+) -> list[tuple[str | None, str]]:
+    """Each missing key (None: the table's own problem) and each unknown key (its name), with
+    a message listing the valid keys: missing ones first, in the order of ``required``."""
+    required, optional = tuple(required), tuple(optional)
+    valid = ", ".join((*required, *optional))
+    missing = [(None, f"missing key '{n}' (keys: {valid})") for n in required if n not in table]
+    unknown = [
+        (name, f"unknown key; valid keys: {valid}")
+        for name in table
+        if name not in required and name not in optional
+    ]
+    return [*missing, *unknown]
 
 
 def _present(value: Any) -> None:

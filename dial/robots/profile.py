@@ -8,6 +8,7 @@ key; :mod:`dial.robots.check` then resolves the names against the compiled model
 
 from __future__ import annotations
 
+import functools
 import re
 import tomllib
 from collections.abc import Callable
@@ -16,10 +17,12 @@ from pathlib import Path
 from typing import Any, Literal, TypeVar
 
 from dial.errors import Diagnostic, DialError, Span
+from dial.resources import data_dir
 from dial.robots.fields import Fields, Invalid, Problem
 from dial.robots.locate import locate, nearest
 
 FILE = "robot.toml"
+DEFAULT_ROBOT = "utah_hand_puma"  # a world file that names no robot runs on this one
 LOADS: tuple[str, ...] = ("tendon", "actuator", "joint")
 # The fingers, in mask order: the masks have 16 bits, bit 4 f + j for finger f, joint j.
 FINGER_NAMES = ("index", "middle", "ring", "thumb")
@@ -208,6 +211,12 @@ def load_profile(folder: Path) -> RobotProfile:
     if problems or profile is None:
         raise RobotFileError(diagnostics(parts.path, text, problems))
     return profile
+
+
+@functools.cache
+def default_profile() -> RobotProfile:
+    """The default robot's profile (``models/utah_hand_puma/robot.toml``), read once."""
+    return load_profile(data_dir("models") / DEFAULT_ROBOT)
 
 
 def _parts(f: Fields, path: Path, data: dict[str, Any]) -> Parts:

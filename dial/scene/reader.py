@@ -8,6 +8,7 @@ from pathlib import Path
 from typing import Any
 
 from dial.errors import DialError
+from dial.robots.fields import key_problems
 
 
 class WorldFileError(DialError, ValueError):
@@ -78,22 +79,6 @@ class Reader:
         if not isinstance(value, list) or not value:
             raise self.error(key, f"expected a non-empty list of strings, got {_kind(value)}")
         return tuple(self.string(v, f"{key}[{i}]") for i, v in enumerate(value))
-
-
-def key_problems(
-    table: Mapping[str, Any], required: Iterable[str], optional: Iterable[str]
-) -> list[tuple[str | None, str]]:
-    """Each missing key (None: the table's own problem) and each unknown key (its name), with
-    a message listing the valid keys: missing ones first, in the order of ``required``."""
-    required, optional = tuple(required), tuple(optional)
-    valid = ", ".join((*required, *optional))
-    missing = [(None, f"missing key '{n}' (keys: {valid})") for n in required if n not in table]
-    unknown = [
-        (name, f"unknown key; valid keys: {valid}")
-        for name in table
-        if name not in required and name not in optional
-    ]
-    return [*missing, *unknown]
 
 
 def _join(key: str, name: str) -> str:

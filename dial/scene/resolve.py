@@ -13,9 +13,10 @@ from pathlib import Path
 
 from dial.instructions.scene_names import SceneNotFoundError
 from dial.resources import data_dir
+from dial.robots.profile import DEFAULT_ROBOT, FILE
 
-ROBOT_DIR = "utah_hand_puma"  # the default robot: a world file that names none runs on it
-ROBOT_FILE = "robot.toml"
+ROBOT_DIR = DEFAULT_ROBOT  # the default robot: a world file that names none runs on it
+ROBOT_FILE = FILE
 # The shared hand-pose file sits beside the world files but is not a scene.
 POSES_FILE = "hand_poses.toml"
 

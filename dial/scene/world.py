@@ -119,6 +119,7 @@ class World:
             programs=frozenset(self.programs),
             objects=frozenset(self.objects),
             anchored=frozenset(n for n, loc in self.locations.items() if loc.body is not None),
+            robot=robot_facts(self.robot),
         )
 
 
