@@ -26,6 +26,7 @@ POS_TOL = 5e-4  # m
 ROT_TOL = 2e-3  # rad
 SOLVE_ITERATIONS = 200  # per start of ArmIK.solve
 DAMPING = 1e-3  # mink's Levenberg-Marquardt damping of every step
+NEAR = 20.0  # within this many tolerances of the target, the posture task is left out
 
 
 class IKError(DialError):
@@ -112,9 +113,12 @@ class ArmIK(_Base):
             perr, rerr = float(np.linalg.norm(err[:3])), float(np.linalg.norm(err[3:]))
             if perr < POS_TOL and rerr < ROT_TOL:
                 break
+            # A posture task (a redundant arm) chooses the basin from afar; near the target
+            # it would pull the tool off it, so the last steps are the frame task's alone.
+            near = perr < NEAR * POS_TOL and rerr < NEAR * ROT_TOL
             vel = mink.solve_ik(
                 self.config,
-                self.tasks,
+                self.tasks[:1] if near else self.tasks,
                 DT,
                 SOLVER,
                 damping=DAMPING,

@@ -42,7 +42,7 @@ LINE_TURN_STEP = np.radians(2.0)  # rad
 class Segment:
     """One piece of an arm motion: joint-interpolated, or a straight tool line.
 
-    ``waypoints`` (N + 1, 6): a line's joint configurations at u = k / N along it, from its
+    ``waypoints`` (N + 1, arm joints): a line's joint configurations at u = k / N along it, from its
     start to its goal; two rows (its ends) for a joint-interpolated segment.
     """
 
@@ -67,12 +67,12 @@ class Segment:
 
     @cached_property
     def steps(self) -> FloatArray:
-        """(N, 6): each waypoint's difference to the next (b - a, worked out once)."""
+        """(N, arm joints): each waypoint's difference to the next (b - a, worked out once)."""
         steps: FloatArray = self.waypoints[1:] - self.waypoints[:-1]
         return steps
 
     def at_array(self, u: FloatArray) -> FloatArray:
-        """(K, 6): :meth:`at` of each fraction, bit for bit."""
+        """(K, arm joints): :meth:`at` of each fraction, bit for bit."""
         last = len(self.waypoints) - 1
         x = np.minimum(1.0, np.maximum(0.0, u)) * last
         k = np.minimum(x.astype(np.intp), last - 1)
@@ -222,7 +222,8 @@ class ArmMotion(RobotPrimitive):
         return self.slots.arm_course(self._rows(np.array(wanted)))
 
     def _rows(self, p: FloatArray) -> FloatArray:
-        """(len(p), 6): :meth:`step`'s set-points at each progress in ``p``, bit for bit."""
+        """(len(p), arm joints): :meth:`step`'s set-points at each progress in ``p``, bit for
+        bit."""
         if len(self.segments) == 1:
             return self.segments[0].at_array(smooth_array(p / max(self.bounds[0], 1e-12)))
         ends = self._ends
@@ -230,7 +231,7 @@ class ArmMotion(RobotPrimitive):
         which = np.minimum(np.searchsorted(ends + 1e-12, p, side="left"), len(ends) - 1)
         starts = self._starts[which]
         u = smooth_array((p - starts) / np.maximum(ends[which] - starts, 1e-12))
-        rows = np.empty((len(p), 6))
+        rows = np.empty((len(p), len(self.q)))
         for j in range(int(which[0]), int(which[-1]) + 1):  # progress only grows
             rows[which == j] = self.segments[j].at_array(u[which == j])
         return rows

@@ -17,14 +17,14 @@ from tests.model.test_tactile import components
 FINGERS = ("index", "middle", "ring", "thumb")
 PRESSES = {
     "flat": (0.0, 0.0),
-    "distal": (0.15, 0.0),
-    "proximal": (-0.15, 0.0),
+    "distal": (0.3, 0.0),
+    "proximal": (-0.3, 0.0),
     "plus_y": (0.0, 0.3),
     "minus_y": (0.0, -0.3),
 }
 PAD_X = 0.0123  # the pad face, along the distal body's +x
-PAD_Z = {"index": 0.0131, "middle": 0.0131, "ring": 0.0131, "thumb": 0.0287}
-PLATE_HALF = np.array([0.004, 0.014, 0.016])
+PAD_Z = {"index": 0.0152, "middle": 0.0152, "ring": 0.0152, "thumb": 0.0308}
+PLATE_HALF = np.array([0.004, 0.018, 0.016])
 # The joint that swings each pad into a plate in front of it: the first flexion beyond the
 # palm (the thumb's j2, its first flexion joint beyond the opposition joint).
 PRESSING = {"index": 1, "middle": 5, "ring": 9, "thumb": 14}
