@@ -14,6 +14,7 @@ import copy
 import functools
 import os
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import mujoco
 import numpy as np
@@ -24,6 +25,9 @@ from dial.errors import DialError
 from dial.resources import data_dir
 from dial.robot.view import FingerView, RobotView
 from dial.robots.profile import RobotProfile, default_profile, load_profile
+
+if TYPE_CHECKING:
+    from dial.scene.world import World
 
 __all__ = [
     "ARM_HOME",
@@ -36,6 +40,8 @@ __all__ = [
     "hand_ctrl",
     "joint_loads",
     "load_model",
+    "rest_hand",
+    "scene_bodies",
     "tactile_images",
     "tendon_differentials",
     "tendon_tensions",
@@ -204,6 +210,19 @@ def hand_bodies(model: mujoco.MjModel, index: RobotIndex) -> frozenset[int]:
     return frozenset(out)
 
 
+def scene_bodies(model: mujoco.MjModel, world: World) -> list[int]:
+    """Bodies a perturbation moves: every free body, and the world file's fixed objects."""
+    named = {
+        int(mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, b)) for b in world.objects.values()
+    }
+    free = {
+        int(model.jnt_bodyid[j])
+        for j in range(model.njnt)
+        if model.jnt_type[j] == mujoco.mjtJoint.mjJNT_FREE
+    }
+    return sorted(named | free)
+
+
 def robot_view(model: mujoco.MjModel, index: RobotIndex) -> RobotView:
     """The read-only view of the robot in ``model`` (its ranges as the model has them)."""
     profile = index.profile
@@ -246,6 +265,15 @@ def hand_ctrl(q_desired: ArrayLike, index: RobotIndex | None = None) -> FloatArr
         bits = slice(None) if index is None else index.hand_bits
         return np.repeat(q[bits], 2)
     return q[index.hand_bits]
+
+
+def rest_hand(model: mujoco.MjModel, data: mujoco.MjData, index: RobotIndex) -> None:
+    """The hand straight, each joint at 0 or its nearest limit (a joint whose range leaves
+    out 0: the Allegro's thumb base), its servos holding there."""
+    joints = model.dof_jntid[index.hand_dof]
+    lo, hi = model.jnt_range[joints].T
+    data.qpos[index.hand_qpos] = np.clip(data.qpos[index.hand_qpos], lo, hi)
+    data.ctrl[hand_actuators(index)] = hand_ctrl(hand_angles(data, index), index)
 
 
 def hand_actuators(index: RobotIndex) -> IntArray:

@@ -13,11 +13,24 @@ from typing import TYPE_CHECKING
 
 from dial.instructions.limits import drive_problem
 from dial.instructions.types import FINGERS
+from dial.robots.facts import RobotFacts, default_facts
 
 if TYPE_CHECKING:
-    from dial.robots.facts import RobotFacts
+    from dial.errors import Span
+    from dial.parser.ast import Definition
+    from dial.parser.bind import Bound
 
 Problem = tuple[str | None, str]  # the parameter it is about (None: the instruction), message
+
+
+def robot_errors(d: Definition, bound: Bound, robot: RobotFacts | None) -> list[tuple[Span, str]]:
+    """Each problem of one bound event on ``robot`` (the default robot when None), at the
+    parameter it is about (else the instruction)."""
+    problems = robot_problems(d.instruction, bound.args, robot or default_facts())
+    return [
+        (bound.spans.get(param, d.instruction_span) if param else d.instruction_span, message)
+        for param, message in problems
+    ]
 
 
 def robot_problems(
@@ -33,16 +46,18 @@ def robot_problems(
                 out += _mask(name, mask, robot)
     out += _tactile(instruction, args, robot)
     if instruction == "puma_command" and args.get("verb") == "drive":
-        joint, angle = args["joint"], args["angle"]
-        assert isinstance(joint, int) and isinstance(angle, float)
-        if not 1 <= joint <= len(robot.arm_ranges):
-            arm = f"the {robot.arm_name} has joints 1 to {len(robot.arm_ranges)}"
-            out.append(("joint", f"robot '{robot.name}': {arm}, not {joint}"))
-        else:
-            problem = drive_problem(joint, angle, robot.arm_ranges, robot.arm_name)
-            if problem is not None:
-                out.append((None, problem))
+        out += _drive(args.get("joint"), args.get("angle"), robot)
     return out
+
+
+def _drive(joint: object, angle: object, robot: RobotFacts) -> list[Problem]:
+    if not isinstance(joint, int) or not isinstance(angle, float):
+        return []  # a bad number: the binder reports it
+    if not 1 <= joint <= len(robot.arm_ranges):
+        arm = f"the {robot.arm_name} has joints 1 to {len(robot.arm_ranges)}"
+        return [("joint", f"robot '{robot.name}': {arm}, not {joint}")]
+    problem = drive_problem(joint, angle, robot.arm_ranges, robot.arm_name)
+    return [] if problem is None else [(None, problem)]
 
 
 def _mask(name: str, mask: int, robot: RobotFacts) -> list[Problem]:

@@ -10,12 +10,9 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 from dial.errors import DialError
-
-if TYPE_CHECKING:
-    from dial.robots.facts import RobotFacts
+from dial.robots.facts import RobotFacts
 
 
 @dataclass(frozen=True)

@@ -17,10 +17,16 @@ import numpy as np
 
 from dial.backend.driver import MujocoRobot
 from dial.backend.ik import ArmIK
-from dial.backend.model import finger_bodies, load_model, load_untextured, profile_at
-from dial.engine.setup import rest_hand, scene_bodies
+from dial.backend.model import (
+    finger_bodies,
+    load_model,
+    load_untextured,
+    profile_at,
+    rest_hand,
+    scene_bodies,
+)
 from dial.preview.ik import FingerIKOnDemand, LeanArmIK
-from dial.primitives import Context
+from dial.primitives.context import Context
 from dial.robot.snapshot import FloatArray
 from dial.scene.world import World
 from dial.teach.contacts import FIXED_DEPTH, OBJECT_DEPTH, Parts

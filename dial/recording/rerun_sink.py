@@ -40,6 +40,15 @@ from dial.recording import layout
 from dial.recording.frames import Batch
 from dial.recording.geometry import Shape, body_paths, moving_bodies, shapes, superquadric_mesh
 from dial.recording.lanes import STATE_COLORS, LanePlan, Lanes, Phase
+from dial.recording.styles import (
+    EXTENSOR_SHADE,
+    JOINT_COLORS,
+    JOINTS,
+    TASK_COLOR,
+    arm_series,
+    finger_series,
+    shade,
+)
 from dial.recording.task import Series
 from dial.recording.timeline import describe, when
 from dial.robot.snapshot import FloatArray
@@ -48,12 +57,6 @@ from dial.robots.profile import RobotProfile
 APP_ID = "dial"
 TACTILE_MM = 1.0  # the colour scale's top: a firm press is 0.5-1 mm deep
 TACTILE_GAP = 3  # taxels between two fingertips' images
-JOINTS = ("abd", "mcp", "pip", "dip")
-JOINT_COLORS = ((255, 202, 40), (239, 83, 80), (102, 187, 106), (66, 165, 245))
-EXTENSOR_SHADE = 0.55  # an extensor is drawn in its joint's colour, darker
-ARM_COLORS = [(239, 83, 80), (255, 167, 38), (255, 238, 88), (102, 187, 106), (66, 165, 245)]
-ARM_COLORS += [(171, 71, 188), (141, 110, 99)]
-TASK_COLOR = (255, 255, 255)
 GUARD_COLOR, POINT_COLOR, FIT_COLOR = (255, 80, 40), (40, 160, 255), (255, 200, 0, 140)
 GUARD_SHOWN_S = 2.0  # simulated seconds a guard's contact marker stays
 LEVELS = {"info": "INFO", "warn": "WARN", "error": "ERROR"}  # rerun's TextLogLevel
@@ -102,11 +105,6 @@ def _archetype(shape: Shape) -> Any:
     return rr.Mesh3D(
         vertex_positions=shape.vertices, triangle_indices=shape.faces, albedo_factor=color
     )
-
-
-def _shade(color: tuple[int, int, int], factor: float) -> tuple[int, int, int]:
-    r, g, b = (round(c * factor) for c in color)
-    return (r, g, b)
 
 
 class RerunSink:
@@ -189,27 +187,12 @@ class RerunSink:
     def _styles(self, task: Sequence[Series]) -> None:
         """Series names and colours: a joint's colour is the same in every finger's plot."""
         rec = self.rec
-        tendons = self._profile.hand.load == "tendon"
-        for finger, joints in zip(FINGERS, self._profile.fingers, strict=True):
-            names = [f"{finger} {j}" for j in JOINTS[: len(joints.joints)]]
-            colors = list(JOINT_COLORS[: len(names)])
-            rec.log(
-                f"{layout.HAND_JOINTS}/{finger}",
-                rr.SeriesLines(names=names, colors=colors),
-                static=True,
-            )
-            if tendons:
-                names = [f"{n} {k}" for n in names for k in ("flexor", "extensor")]
-                colors = [_shade(c, f) for c in colors for f in (1.0, EXTENSOR_SHADE)]
-            rec.log(
-                f"{layout.TENDONS}/{finger}",
-                rr.SeriesLines(names=names, colors=colors),
-                static=True,
-            )
-        arm = [f"joint {i}" for i in range(1, len(self._profile.arm.joints) + 1)]
-        rec.log(
-            layout.ARM_JOINTS, rr.SeriesLines(names=arm, colors=ARM_COLORS[: len(arm)]), static=True
-        )
+        for finger, joints, loads in finger_series(self._profile):
+            for path, series in ((layout.HAND_JOINTS, joints), (layout.TENDONS, loads)):
+                line = rr.SeriesLines(names=series.names, colors=series.colors)
+                rec.log(f"{path}/{finger}", line, static=True)
+        arm = arm_series(self._profile)
+        rec.log(layout.ARM_JOINTS, rr.SeriesLines(names=arm.names, colors=arm.colors), static=True)
         for path, s in zip(self._task, task, strict=True):
             line = rr.SeriesLines(names=[f"{s.label} ({s.unit})"], colors=[TASK_COLOR], widths=2)
             rec.log(path, line, static=True)
@@ -250,7 +233,7 @@ class RerunSink:
         )
         swatches = [
             *zip(JOINTS, JOINT_COLORS, strict=True),
-            ("extensor darker", _shade((200, 200, 200), EXTENSOR_SHADE)),
+            ("extensor darker", shade((200, 200, 200), EXTENSOR_SHADE)),
             ("guard contact", GUARD_COLOR),
             ("touched point", POINT_COLOR),
         ]

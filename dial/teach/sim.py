@@ -24,8 +24,8 @@ from dial.backend.model import (
     hand_ctrl,
     load_model,
     profile_at,
+    rest_hand,
 )
-from dial.engine.setup import rest_hand
 from dial.geometry import location_pose, rpy_matrix, smooth
 from dial.primitives.arm import Segment
 from dial.primitives.context import Context

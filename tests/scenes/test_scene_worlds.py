@@ -43,6 +43,9 @@ PAPER_PROGRAMS = {
     "lightbulb": {"to_bulb", "lower_to_bulb", "twist_wrist", "twist_CW", "retract_arm"},
     "pour": {"get_top", "lift_top", "to_grasp", "pour", "retract_arm"},
 }
+# The quarter turns lightbulb.dial and pour.dial ask of the arm's last joint (the PUMA's joint
+# 6), as world programs so that the scripts run on another arm.
+TURNS = {"lightbulb": {"turn_probe", "turn_back"}, "pour": {"turn_wrist", "turn_back"}}
 PAPER_POSES = {"open_hand", "prelight", "unscrew", "ungrasp", "point", "prepit"}
 
 
@@ -68,7 +71,7 @@ def test_load_scene_names_reports_masks_locations_programs() -> None:
     assert names.poses["ungrasp"] == 0xEEEF  # flexion, and the index abducts with the middle
     assert names.poses["point_down"] == 0x000F
     assert "above_bulb" in names.locations
-    assert names.programs == PAPER_PROGRAMS["lightbulb"]
+    assert names.programs == PAPER_PROGRAMS["lightbulb"] | TURNS["lightbulb"]
 
 
 def test_scene_path_wins_over_bundled_name(tmp_path: Path) -> None:
