@@ -26,8 +26,8 @@ PAD_X = 0.0123  # the pad face, along the distal body's +x
 PAD_Z = {"index": 0.0152, "middle": 0.0152, "ring": 0.0152, "thumb": 0.0308}
 PLATE_HALF = np.array([0.004, 0.018, 0.016])
 # The joint that swings each pad into a plate in front of it: the first flexion beyond the
-# palm (the thumb's j2, its first flexion joint beyond the opposition joint).
-PRESSING = {"index": 1, "middle": 5, "ring": 9, "thumb": 14}
+# palm (the thumb's j1, its first flexion joint).
+PRESSING = {"index": 1, "middle": 5, "ring": 9, "thumb": 13}
 
 
 def plate(
