@@ -28,8 +28,16 @@ HAND_RANGES: dict[str, tuple[float, float]] = {
 _SLACK = 1e-6  # rad: a value written as the limit in degrees is within it
 
 
-def _deg(rad: float) -> str:
-    return f"{round(math.degrees(rad), 1):g}"
+def _deg(rad: float, digits: int = 1) -> str:
+    return f"{round(math.degrees(rad), digits):g}"
+
+
+def _digits(excess: float) -> int:
+    """Decimals that show an excess (rad) as more than 0 deg (a limit of 79.98 deg, not 80)."""
+    digits = 1
+    while digits < 4 and round(math.degrees(excess), digits) == 0:
+        digits += 1
+    return digits
 
 
 def drive_problem(
@@ -65,7 +73,8 @@ def hand_problem(kind: str, angle: float, limits: tuple[float, float] | None = N
         return None
     limit, excess = (lo, lo - angle) if angle < lo else (hi, angle - hi)
     side = "lower" if angle < lo else "upper"
+    n = _digits(excess)
     return (
-        f"{_deg(angle)} deg is beyond the {kind} joint's {side} limit of {_deg(limit)} deg "
-        f"by {_deg(excess)} deg (its range is {_deg(lo)} to {_deg(hi)} deg)"
+        f"{_deg(angle, n)} deg is beyond the {kind} joint's {side} limit of {_deg(limit, n)} deg "
+        f"by {_deg(excess, n)} deg (its range is {_deg(lo, n)} to {_deg(hi, n)} deg)"
     )

@@ -62,3 +62,14 @@ def test_bundled_names_of_every_robot() -> None:
     for name in ("lib/containment", "hand_poses", "allegro_panda/hand_poses", "x/pour"):
         with pytest.raises(LookupError):
             resolve_scene(name, Path("/"))
+
+
+def test_a_pose_checked_against_the_worlds_robot_shows_a_small_excess(tmp_path: Path) -> None:
+    # The Allegro thumb's opposition joint ends at 1.396 rad (79.98 deg): 80 is just beyond,
+    # and the message says by how much rather than "beyond 80 by 0".
+    path = world(tmp_path, 'robot = "allegro_panda"')
+    path.write_text(path.read_text() + "[poses.p]\nthumb = [80, 0, 0, 0]\n")
+    with pytest.raises(WorldFileError) as info:
+        load_world(path)
+    message = "80 deg is beyond the abd joint's upper limit of 79.98 deg by 0.02 deg"
+    assert message in str(info.value)
