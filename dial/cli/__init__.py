@@ -27,8 +27,9 @@ exit status: 0 ok, 1 script error (or, for fmt --check, a file that would change
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="dial",
-        description="Run DIAL-style tick-based timeline scripts on a simulated "
-        "Utah/MIT hand on a PUMA 560.",
+        description="Run DIAL-style tick-based timeline scripts on a simulated robot hand and\n"
+        "arm: the Utah/MIT hand on a PUMA 560, an Allegro-like hand on a Panda-like arm\n"
+        "(dial robots), or a robot folder of your own (docs/robots.md).",
         epilog=EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )

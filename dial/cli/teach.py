@@ -47,7 +47,11 @@ def add_parsers(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> Non
         "relative to an object), the programs and the success criteria. With --picture, "
         "also render the scene with every location drawn as a labelled frame.",
     )
-    p.add_argument("scene", metavar="SCENE", help="a bundled scene name or a world file path")
+    p.add_argument(
+        "scene",
+        metavar="SCENE",
+        help="a bundled scene name (ROBOT/NAME for another robot's) or a world file path",
+    )
     p.add_argument("--picture", metavar="FILE.png", help="draw the named frames over the scene")
     p.set_defaults(func=cmd_world)
 
