@@ -49,6 +49,7 @@ class RunOptions:
     perturb_mm: float = 0.0
     disturb: Sequence[Disturbance] = ()
     realtime: bool = False
+    pace: float | None = None  # wall s per simulated s (--realtime is 1); None: unpaced
     log: TextIO | None = None  # the JSON Lines sink, written and flushed record by record
     log_states: bool = False
     progress: Progress | None = None
@@ -59,6 +60,7 @@ class RunOptions:
     console: Console | None = None
     save_at: tuple[int, Path] | None = None  # (block number, state file)
     resume: Saved | None = None  # a state file to go on from (its settings win)
+    stop: StopRequest | None = None  # polled every period; also set by SIGINT and SIGTERM
 
 
 def tick_length(script: Script, options: RunOptions) -> float:
@@ -81,7 +83,7 @@ def run(script: Script, options: RunOptions) -> RunResult:
     SIGINT and SIGTERM stop the run at the next control period, from the scene's loading on:
     every effector holds, and the log ends with ``interrupted`` and ``summary``.
     """
-    stop = StopRequest()
+    stop = options.stop or StopRequest()
     with catch_stop_signals(stop):
         log = EventLog(options.log)
         settings = _settings(script, options)
@@ -102,7 +104,7 @@ def run(script: Script, options: RunOptions) -> RunResult:
                 log,
                 progress=options.progress,
                 observe=fan_out(begun),
-                pace=1.0 if options.realtime else None,
+                pace=1.0 if options.realtime else options.pace,
                 stop=stop,
             )
             hooks = runner.hooks = _debugging(script, runner, ctx, stop, settings, begun, options)
