@@ -12,7 +12,7 @@ import sys
 from collections.abc import Sequence
 
 from dial import __version__
-from dial.cli import preview, replay, run, teach, text, tune
+from dial.cli import preview, remote, replay, run, teach, text, tune
 from dial.cli.common import Terminated
 from dial.errors import DialError, OptionError, ScriptError
 
@@ -40,6 +40,7 @@ def build_parser() -> argparse.ArgumentParser:
     tune.add_parser(sub)
     teach.add_parsers(sub)
     preview.add_parser(sub)
+    remote.add_parsers(sub)
     return parser
 
 

@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING
 
 from dial import api
 from dial.cli.common import UsageError, load_script, scene_argument
+from dial.cli.remote import add_run_options, check_remote
 from dial.recording.timeline import qualified_event
 from dial.scheduler.signals import EXIT_STATUS, StopRequest, catch_stop_signals
 
@@ -110,6 +111,7 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         help="go on from a state file (with its tick, seed, perturbation and disturbances); "
         "lines of the script before the saved block must be unchanged",
     )
+    add_run_options(p)
     p.set_defaults(func=cmd_run)
 
 
@@ -125,11 +127,16 @@ def _run(args: argparse.Namespace, stop: StopRequest) -> int:
     if args.log_states and not args.log:
         raise UsageError("--log-states writes into the log: give --log FILE.jsonl too")
     api.check_options(args.tick, args.speed, args.seed, args.perturb)
+    check_remote(args)
     save_at = _save_at(args.save_at)
     script = load_script(args.script, args.scene)
     if stop.signal is not None:  # while the script was being checked
         print(f"dial: interrupted by {stop.signal}", file=sys.stderr)
         return EXIT_STATUS[stop.signal]
+    if args.remote is not None:
+        from dial.cli.run_remote import run_remote
+
+        return run_remote(args, script, stop, _progress(args.quiet), summary_text)
     result = api.run(
         script,
         tick=args.tick,

@@ -18,7 +18,6 @@ from __future__ import annotations
 import dataclasses
 import queue
 import time
-from collections.abc import Mapping
 
 import trio
 
@@ -137,13 +136,13 @@ class BlockRunner(Runner[Snapshot]):
             seq, ident = command.integer("seq"), command.text("id")
             if command.integer("after") != self.last:
                 why = f"it follows command {command.integer('after')}, which did not run"
-                self._refuse(command, "dropped", why)
+                self._refuse(command, "dropped", why, loop.tick)
                 continue
             if command.integer("tick") <= loop.tick:
                 why = (
                     f"tick {command.integer('tick')} had passed (the robot is at tick {loop.tick})"
                 )
-                self._refuse(command, "late", why + "; the robot holds")
+                self._refuse(command, "late", why + "; the robot holds", loop.tick)
                 continue
             if command.type == "end":
                 self.last = seq
@@ -153,7 +152,7 @@ class BlockRunner(Runner[Snapshot]):
             found = steps.get((command.text("script"), _line(command)))
             problem = self._mismatch(command, found)
             if problem is not None:
-                self._refuse(command, "mismatch", problem)
+                self._refuse(command, "mismatch", problem, loop.tick)
                 continue
             assert found is not None
             owner, step = found
@@ -182,9 +181,12 @@ class BlockRunner(Runner[Snapshot]):
             self.log.write("idle", tick=loop.tick + 1, t=loop.sim_time)
         await loop.block(script, IDLE)
 
-    def _refuse(self, command: Message, code: str, message: str) -> None:
-        seq, ident = command.integer("seq"), command.text("id")
-        self.session.report("refused", seq=seq, id=ident, code=code, message=message)
+    def _refuse(self, command: Message, code: str, message: str, tick: int) -> None:
+        """Refuse a command: the robot's tick and the command it follows go with it."""
+        seq, ident, after = command.integer("seq"), command.text("id"), command.integer("after")
+        self.session.report(
+            "refused", seq=seq, id=ident, code=code, message=message, tick=tick, after=after
+        )
 
     @staticmethod
     def _mismatch(command: Message, found: tuple[Script, Step] | None) -> str | None:
@@ -215,7 +217,11 @@ def _line(command: Message) -> int:
 
 
 def run_blocks(
-    session: Session, config: RobotConfig, script: Script, tick: float, telemetry: Telemetry
+    session: Session,
+    config: RobotConfig,
+    script: Script,
+    first: Message,
+    telemetry: Telemetry,
 ) -> RunResult:
     """A ``--split block`` session's run: set up as ``dial run`` does, then take commands."""
     from dial.remote.session import Tee
@@ -227,14 +233,14 @@ def run_blocks(
     runner = BlockRunner(
         robot,
         make_factory(ctx),
-        tick,
+        first.number("tick_length"),
         log,
         observe=fan_out([telemetry]),
         pace=config.pace,
         stop=session.stop,
     )
     runner.session = session
-    runner.last = 1
+    runner.last = first.integer("seq")  # 'open': the first block follows it
     start, cpu = time.perf_counter(), time.process_time()
     summary = trio.run(runner.run, script)
     wall, cpu = time.perf_counter() - start, time.process_time() - cpu
@@ -252,8 +258,3 @@ def run_blocks(
     )
     log.write("summary", **result.as_record())
     return result
-
-
-def step_key(script: Script, step: Step) -> Mapping[str, object]:
-    """Where a block or condition sits: the script's path and its line."""
-    return {"script": script.path, "line": getattr(step, "line", 0)}

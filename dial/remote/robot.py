@@ -170,7 +170,7 @@ def _run(
         return run_engine(script, options)
     from dial.remote.blocks import run_blocks
 
-    return run_blocks(session, config, script, tick, telemetry)
+    return run_blocks(session, config, script, first, telemetry)
 
 
 def _disturbances(texts: Sequence[str]) -> list[Disturbance]:

@@ -38,7 +38,7 @@ from dial.remote.session import Session
 from dial.remote.tokens import same_token
 
 
-@dataclass
+@dataclass(eq=False)
 class Conn:
     """One WebSocket connection to the server."""
 
@@ -104,6 +104,14 @@ class Server:
 
     # -- one connection -----------------------------------------------------------------------
     async def handle(self, request: WebSocketRequest) -> None:
+        """One connection; whatever goes wrong in it, the server keeps serving."""
+        try:
+            await self._handle(request)
+        except Exception as e:  # a bug must not take the robot's server down
+            what = "; ".join(str(x) for x in getattr(e, "exceptions", [e]))
+            print(f"dial serve: a connection failed: {type(e).__name__}: {what}", file=sys.stderr)
+
+    async def _handle(self, request: WebSocketRequest) -> None:
         conn = Conn(await request.accept())
         self.conns.add(conn)
         try:
@@ -141,7 +149,13 @@ class Server:
             await self._command(conn, msg)
 
     async def _sender(self, conn: Conn) -> None:
-        """Reports (each once, in order), the latest telemetry, and heartbeats."""
+        """Reports (each once, in order), the latest telemetry, and heartbeats; until the
+        connection closes."""
+        with contextlib.suppress(ConnectionClosed, trio.BrokenResourceError):
+            await self._send_all(conn)
+        conn.closing = True
+
+    async def _send_all(self, conn: Conn) -> None:
         due = trio.current_time()
         while True:
             s = conn.session

@@ -1,0 +1,166 @@
+"""Prediction: the operator runs the script on its own believed world, with physics, ahead
+of the delayed telemetry, and says where the robot's reports leave it.
+
+The predicted run is a local run (no perturbation, no disturbance: what the operator
+believes), unpaced, in a thread of its own. It keeps the tool's position at every control
+period and its log. A reported sample is compared with the prediction at the same place
+in the same block (the robot may have waited between blocks, ``--split block``): when the
+tool is more than ``--diverge`` mm away, or a run ends with another outcome, or a monitor
+fires that the prediction did not see, the operator writes a ``diverged`` record naming
+the event and the tick (once per departure: a tool back within the bound may diverge again).
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+from collections import defaultdict
+from typing import TYPE_CHECKING
+
+from dial.engine.observe import Watched
+from dial.engine.result import RunResult
+from dial.parser.script import Script
+from dial.remote.protocol import Message
+from dial.scheduler.log import EventLog, Record
+
+if TYPE_CHECKING:
+    from dial.remote.operator import Operator
+
+PERIOD = 0.01  # s, the control period (both sides)
+
+
+class Predictor:
+    """The predicted run (an observer of the local run) and the comparison with reports."""
+
+    what = "the prediction"
+
+    def __init__(self, op: Operator) -> None:
+        self.op = op
+        self.tool: list[tuple[float, float, float]] = []  # mm, per control period from 0
+        self.log: EventLog | None = None
+        self.done = threading.Event()
+        self.error: str | None = None
+        self.robot_blocks: dict[int, int] = {}  # block number -> its first period, reported
+        self.block = 0  # the robot's latest block
+        self.seen: dict[tuple[str, str, int], int] = defaultdict(int)  # reported ends, monitors
+        self.off = False  # the tool is away from the prediction now
+        self.running: dict[tuple[str, int], str] = {}
+
+    # -- the predicted run (in its thread) ------------------------------------------------------
+    def begin(self, run: Watched) -> None:
+        self.robot, self.log = run.robot, run.log
+        self._sample()
+
+    def period(self, periods: int, tick: int) -> None:
+        self._sample()
+
+    def end(self, result: RunResult | None) -> None:
+        pass
+
+    def _sample(self) -> None:
+        d, ix = self.robot.data, self.robot.index
+        x, y, z = (float(v) * 1000.0 for v in d.site_xpos[ix.tool_site])
+        self.tool.append((x, y, z))
+
+    def _predicted(self, kind: str) -> list[Record]:
+        return [] if self.log is None else [r for r in self.log.records if r["kind"] == kind]
+
+    # -- the reports (in the operator's trio thread) --------------------------------------------
+    def reported(self, record: Record) -> None:
+        kind = record.get("kind")
+        if kind == "block":
+            number, t = record.get("number"), record.get("t")
+            if isinstance(number, int) and isinstance(t, int | float):
+                self.robot_blocks[number] = round(t / PERIOD)
+                self.block = number
+        elif kind == "start":
+            self.running[(str(record.get("event")), _int(record.get("line")))] = str(
+                record.get("event")
+            )
+        elif kind in ("end", "monitor"):
+            if kind == "end":
+                self.running.pop((str(record.get("event")), _int(record.get("line"))), None)
+            self._compare(kind, record)
+
+    def _compare(self, kind: str, record: Record) -> None:
+        """The k-th end (monitor) of an event's line against the prediction's k-th."""
+        key = (kind, str(record.get("event")), _int(record.get("line")))
+        k = self.seen[key]
+        self.seen[key] += 1
+        same = [
+            r
+            for r in self._predicted(kind)
+            if r.get("event") == key[1] and _int(r.get("line")) == key[2]
+        ]
+        if k >= len(same) and not self.done.is_set():
+            return  # the prediction has not got there yet: it is behind, not wrong
+        predicted = same[k].get("outcome", "fired") if k < len(same) else "nothing"
+        reported = record.get("outcome", "fired")
+        if predicted != reported:
+            self.op.out.link(
+                "diverged",
+                what="outcome" if kind == "end" else "monitor",
+                event=key[1],
+                line=key[2],
+                tick=record.get("tick"),
+                reported=reported,
+                predicted=predicted,
+            )
+
+    def telemetry(self, msg: Message) -> None:
+        start = self.robot_blocks.get(self.block)
+        predicted = self._block_start(self.block)
+        if start is None or predicted is None:
+            return
+        offset = msg.integer("periods") - start
+        following = self._block_start(self.block + 1)
+        at = predicted + offset if following is None else min(predicted + offset, following)
+        if at >= len(self.tool):
+            return  # not predicted yet
+        tool = [float(v) for v in msg.items("tool") if isinstance(v, int | float)]
+        if len(tool) != 3:
+            return
+        distance = math.dist(tool, self.tool[at])
+        limit = self.op.options.diverge_mm
+        if distance > limit and not self.off:
+            events = sorted(set(self.running.values()))
+            self.op.out.link(
+                "diverged",
+                what="tool",
+                event=", ".join(events) if events else None,
+                tick=msg.integer("tick"),
+                t=msg.number("t"),
+                distance_mm=round(distance, 2),
+                limit_mm=limit,
+            )
+        self.off = distance > limit
+
+    def _block_start(self, number: int) -> int | None:
+        for r in self._predicted("block"):
+            if r.get("number") == number:
+                t = r.get("t")
+                return round(t / PERIOD) if isinstance(t, int | float) else None
+        return None
+
+
+def _int(value: object) -> int:
+    return value if isinstance(value, int) else 0
+
+
+async def start_prediction(script: Script, op: Operator) -> Predictor:
+    """Start the predicted run in a thread; the predictor compares as reports arrive."""
+    predictor = Predictor(op)
+
+    def predict() -> None:
+        from dial.engine.run import RunOptions
+        from dial.engine.run import run as run_engine
+
+        try:
+            run_engine(script, RunOptions(tick=op.options.tick, observers=[predictor]))
+        except Exception as e:  # the prediction is advice: the remote run goes on without it
+            predictor.error = str(e)
+        finally:
+            predictor.done.set()
+
+    threading.Thread(target=predict, daemon=True, name="dial-prediction").start()
+    return predictor

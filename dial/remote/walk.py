@@ -1,0 +1,171 @@
+"""What the operator sends: the whole script (``--split script``), or the timeline walked
+block by block (``--split block``, NASREM level 4).
+
+The walk follows the runner's (blocks, ``@repeat``, ``@if``, ``@call``) and tags every
+command with the tick it must start at. A block whose length is known (no watched span,
+so no reaction that could end it early or run on) moves the next tick on by its length, so
+the next block can be sent at once, ahead of time. A condition is tested at the robot, and
+the branch or loop waits for its result; so does whatever follows a watched block. The
+command after such a wait is tagged ``lead`` ticks after the tick the robot reported:
+enough for it to cross the link. A command refused ``late`` is sent again, with those after
+it, ``lead`` ticks after the robot's tick, and the lead doubles.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING
+
+from dial.errors import DialError
+from dial.parser.script import Script, Step, TBlock, TCall, TIf, TRepeat
+from dial.remote.blocks import describe
+from dial.remote.protocol import Message
+
+if TYPE_CHECKING:
+    from dial.remote.operator import Operator
+
+LEAD_MARGIN_S = 0.2  # s added to 1.5 round trips for the default lead
+
+
+async def run_split(script: Script, op: Operator) -> None:
+    """Send the script whole, or open a block session and walk its timeline."""
+    from dial.remote.operator import upload
+
+    ch, tick = op.channel, op.options.tick
+    rtt = await ch.measure_rtt()
+    op.out.link("rtt", seconds=round(rtt, 4))
+    if op.options.split == "script":
+        seq = await ch.command("run", tick=1, after=0, script=upload(script), tick_length=tick)
+        await op.result_of(seq)
+        return
+    seq = await ch.command("open", script=upload(script), tick_length=tick)
+    if (await op.result_of(seq)).type == "refused":
+        return
+    walker = Walker(op, seq, lead_ticks(op, rtt))
+    try:
+        await walker.walk(script, script.timeline)
+    except _Max as e:
+        await walker.end(str(e))
+        return
+    await walker.end(None)
+
+
+def lead_ticks(op: Operator, rtt: float) -> int:
+    """``--lead`` in ticks of the robot's paced time; by default 1.5 round trips and a
+    margin, rounded up to a power of two ticks (so that runs whose round trips differ a
+    little tag the same ticks)."""
+    pace = op.channel.robot.get("pace", 1.0)
+    wall_per_tick = op.options.tick * (float(pace) if isinstance(pace, int | float) else 1.0)
+    given = op.options.lead
+    seconds = given if given is not None else 1.5 * rtt + LEAD_MARGIN_S
+    ticks = max(1, math.ceil(seconds / wall_per_tick))
+    if given is None:
+        ticks = 1 << (ticks - 1).bit_length()
+    op.out.link("lead", seconds=round(seconds, 4), ticks=ticks)
+    return ticks
+
+
+class _Max(Exception):
+    """A loop reached its max at the operator: the run ends with this error."""
+
+
+class Walker:
+    """The operator's walk of a timeline, as commands tagged with ticks."""
+
+    def __init__(self, op: Operator, after: int, lead: int) -> None:
+        self.op, self.after, self.lead = op, after, lead
+        self.next = 1  # the tick the next command starts at, unless it waits on a result
+        self.waiting: int | None = None  # the command whose result tells the next tick
+        # Commands sent since the last result, to send again if one is refused late:
+        # (seq, type, tick, fields).
+        self.chain: list[tuple[int, str, int, dict[str, object]]] = []
+        self.renamed: dict[int, int] = {}  # a refused command's seq -> its re-sent seq
+
+    async def walk(self, script: Script, steps: tuple[Step, ...]) -> None:
+        for step in steps:
+            if isinstance(step, TBlock):
+                length = None if step.reactions else step.length
+                body = describe(script, step)["block"]
+                await self._send("block", length, script=script.path, block=body)
+            elif isinstance(step, TRepeat):
+                await self._repeat(script, step)
+            elif isinstance(step, TIf):
+                then = await self.test(script, step)
+                await self.walk(script, step.then if then else step.orelse)
+            elif isinstance(step, TCall):
+                await self.walk(step.script, step.script.timeline)
+
+    async def _repeat(self, script: Script, step: TRepeat) -> None:
+        for _ in range(step.count):
+            if step.kind == "while" and not await self.test(script, step):
+                return
+            await self.walk(script, step.body)
+            if step.kind == "until" and await self.test(script, step):
+                return
+        if step.kind == "count" or (step.kind == "while" and not await self.test(script, step)):
+            return
+        raise _Max(
+            f"'@repeat {step.kind} {step.condition}' on line {step.line} of {script.path} "
+            f"reached its max of {step.count} iterations"
+        )
+
+    async def test(self, script: Script, step: TIf | TRepeat) -> bool:
+        """A condition, tested at the robot at its tick: wait for its value."""
+        seq = await self._send(
+            "test", None, script=script.path, line=step.line, condition=str(step.condition)
+        )
+        return (await self._result(seq)).fields.get("value") is True
+
+    async def end(self, error: str | None) -> None:
+        await self._send("end", 0, **({} if error is None else {"error": error}))
+
+    async def _send(self, type_: str, length: int | None, **fields: object) -> int:
+        if self.waiting is not None:
+            result = await self._result(self.waiting)
+            self.next = result.integer("tick") + 1 + self.lead
+            self.waiting = None
+            self.chain.clear()
+        tick = self.next
+        seq = await self.op.channel.command(type_, tick=tick, after=self.after, **fields)
+        self.chain.append((seq, type_, tick, fields))
+        self.after = seq
+        if length is None:
+            self.waiting = seq
+        else:
+            self.next = tick + length
+        return seq
+
+    async def _result(self, seq: int) -> Message:
+        while True:
+            seq = self.renamed.get(seq, seq)
+            result = await self.op.result_of(seq)
+            if result.type != "refused":
+                return result
+            code = result.text("code")
+            if code == "dropped" and seq in self.renamed:
+                continue
+            if code != "late":
+                raise DialError(f"the robot refused command {seq}: {result.text('message')}")
+            await self._resend(seq, result)
+
+    async def _resend(self, seq: int, refused: Message) -> None:
+        """Send the late command and those chained after it again, later by one lead more."""
+        self.lead *= 2
+        at = [i for i, c in enumerate(self.chain) if c[0] == seq]
+        if not at:
+            raise DialError(f"the robot refused command {seq} as late, and it was not sent ahead")
+        again = self.chain[at[0] :]
+        shift = refused.integer("tick") + 1 + self.lead - again[0][2]
+        self.after = self.chain[at[0] - 1][0] if at[0] > 0 else again[0][0] - 1
+        self.after = refused.integer("after", self.after)
+        self.chain = self.chain[: at[0]]
+        for old, type_, tick, fields in again:
+            new = await self.op.channel.command(
+                type_, tick=tick + shift, after=self.after, **fields
+            )
+            self.chain.append((new, type_, tick + shift, fields))
+            self.renamed[old] = new
+            self.after = new
+            if self.waiting == old:
+                self.waiting = new
+        self.next += shift
