@@ -48,7 +48,7 @@ from dial.scheduler.log import EventLog, clean
 from dial.scheduler.position import Frame, Path
 from dial.scheduler.runner import Runner
 from dial.scheduler.ticks import TickLoop
-from dial.scheduler.types import RunAborted
+from dial.scheduler.types import Interrupted, RunAborted
 
 IDLE = TBlock(0, 1, ())  # one tick with no run: every effector holds its last command
 
@@ -127,6 +127,7 @@ class BlockRunner(Runner[Snapshot]):
             if isinstance(step, TBlock | TIf | TRepeat)
         }
         self._path.append(Frame(0))
+        await self._first(loop)
         while True:
             command = self._next()
             if command is None or command.integer("tick") > loop.tick + 1:
@@ -166,6 +167,16 @@ class BlockRunner(Runner[Snapshot]):
             self.session.report(
                 "result", seq=seq, id=ident, tick=loop.tick, t=round(loop.sim_time, 6), **fields
             )
+
+    async def _first(self, loop: TickLoop[Snapshot]) -> None:
+        """Before the first command the robot's clock stands still (as a local run's before
+        its first tick); then pacing counts from there."""
+        while self._next() is None:
+            if self.stop.signal is not None:
+                raise Interrupted(self.stop.signal)
+            await trio.sleep(0.002)
+        if loop.pace is not None:
+            loop.t0 = trio.current_time()
 
     def _next(self) -> Message | None:
         if self._head is None:

@@ -18,7 +18,15 @@ import trio
 from trio_websocket import ConnectionClosed, HandshakeError, WebSocketConnection, open_websocket_url
 
 from dial.errors import DialError
-from dial.remote.protocol import MAX_FRAME, TO_OPERATOR, Message, ProtocolError, decode, encode
+from dial.remote.protocol import (
+    CLOSE_S,
+    MAX_FRAME,
+    TO_OPERATOR,
+    Message,
+    ProtocolError,
+    decode,
+    encode,
+)
 
 CONNECT_S = 15.0  # how long the first connection may take (hello and welcome included)
 RETRY_S = 0.1  # between reconnection attempts
@@ -82,7 +90,12 @@ class Channel:
         await self._welcome.wait()
 
     async def _connect(self) -> None:
-        async with open_websocket_url(self.url, max_message_size=MAX_FRAME) as ws:
+        async with open_websocket_url(
+            self.url,
+            max_message_size=MAX_FRAME,
+            connect_timeout=CONNECT_S,
+            disconnect_timeout=CLOSE_S,
+        ) as ws:
             hello: dict[str, object] = {"token": self.token, "role": "operator"}
             if self.session is not None:
                 hello.update(session=self.session, have=self.have)

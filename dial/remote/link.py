@@ -27,7 +27,7 @@ from trio_websocket import (
 )
 
 from dial.errors import OptionError
-from dial.remote.protocol import MAX_FRAME
+from dial.remote.protocol import CLOSE_S, MAX_FRAME
 
 FRAME_OVERHEAD = 8  # bytes a WebSocket frame adds to its payload, about (header, mask)
 _TIME = re.compile(r"^(\d+(?:\.\d*)?|\.\d+)(ms|s)?$")
@@ -153,7 +153,9 @@ class Link:
         client = await request.accept()
         try:
             async with (
-                open_websocket_url(self.target, max_message_size=MAX_FRAME) as server,
+                open_websocket_url(
+                    self.target, max_message_size=MAX_FRAME, disconnect_timeout=CLOSE_S
+                ) as server,
                 trio.open_nursery() as nursery,
             ):
                 nursery.start_soon(self._watch_cut, nursery.cancel_scope)
@@ -162,7 +164,7 @@ class Link:
         except (ConnectionClosed, HandshakeError, OSError, trio.BrokenResourceError):
             pass  # either end went away, or the server refused: the client sees it closed
         finally:
-            with trio.CancelScope(shield=True):
+            with trio.CancelScope(shield=True), trio.move_on_after(CLOSE_S):
                 await client.aclose()
 
     async def _watch_cut(self, scope: trio.CancelScope) -> None:
@@ -217,6 +219,14 @@ async def serve_link(
     """Serve ``link`` on ``host:port`` (0: a free port, reported through ``task_status``)."""
     async with trio.open_nursery() as nursery:
         server = await nursery.start(
-            partial(serve_websocket, link.handle, host, port, None, max_message_size=MAX_FRAME)
+            partial(
+                serve_websocket,
+                link.handle,
+                host,
+                port,
+                None,
+                max_message_size=MAX_FRAME,
+                disconnect_timeout=CLOSE_S,
+            )
         )
         task_status.started(server.port)

@@ -135,7 +135,8 @@ class Operator:
             return
         self.out.reported(record)
         kind = record.get("kind")
-        key = (str(record.get("event")), int(str(record.get("line", 0))))
+        line = record.get("line")
+        key = (str(record.get("event")), line if isinstance(line, int) else 0)
         if kind == "start":
             self.running[key] = str(record.get("event"))
         elif kind == "end":
@@ -163,6 +164,12 @@ class Operator:
     async def wait_finished(self) -> None:
         while self.finished is None:
             await self.arrived.wait()
+
+    async def next_report(self) -> None:
+        """Wait for the next result, refusal or end (raise if the run is over)."""
+        if self.finished is not None:
+            raise _Finished
+        await self.arrived.wait()
 
 
 class _Finished(Exception):
@@ -281,6 +288,11 @@ async def _session(script: Script, op: Operator) -> str | None:
         await op.wait_finished()
     except _Finished:
         pass
+    except DialError as e:  # the robot refused a command: stop it, say why
+        await op.channel.command("stop")
+        with trio.move_on_after(op.channel.watchdog + STOP_WAIT_S):
+            await op.wait_finished()
+        return str(e)
     return op.rejected
 
 

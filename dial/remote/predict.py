@@ -40,11 +40,11 @@ class Predictor:
         self.log: EventLog | None = None
         self.done = threading.Event()
         self.error: str | None = None
-        self.robot_blocks: dict[int, int] = {}  # block number -> its first period, reported
-        self.block = 0  # the robot's latest block
         self.seen: dict[tuple[str, str, int], int] = defaultdict(int)  # reported ends, monitors
         self.off = False  # the tool is away from the prediction now
         self.running: dict[tuple[str, int], str] = {}
+        self._starts: dict[int, int] = {}  # the prediction's blocks: number -> first period
+        self._scanned = 0  # its log records looked at so far
 
     # -- the predicted run (in its thread) ------------------------------------------------------
     def begin(self, run: Watched) -> None:
@@ -68,12 +68,7 @@ class Predictor:
     # -- the reports (in the operator's trio thread) --------------------------------------------
     def reported(self, record: Record) -> None:
         kind = record.get("kind")
-        if kind == "block":
-            number, t = record.get("number"), record.get("t")
-            if isinstance(number, int) and isinstance(t, int | float):
-                self.robot_blocks[number] = round(t / PERIOD)
-                self.block = number
-        elif kind == "start":
+        if kind == "start":
             self.running[(str(record.get("event")), _int(record.get("line")))] = str(
                 record.get("event")
             )
@@ -108,12 +103,13 @@ class Predictor:
             )
 
     def telemetry(self, msg: Message) -> None:
-        start = self.robot_blocks.get(self.block)
-        predicted = self._block_start(self.block)
-        if start is None or predicted is None:
+        """A sample at ``since`` periods into the robot's block ``block``: against the
+        prediction as far into its block (at most to its next block's start)."""
+        block, offset = msg.integer("block"), msg.integer("since")
+        predicted = self._block_start(block)
+        if predicted is None:
             return
-        offset = msg.integer("periods") - start
-        following = self._block_start(self.block + 1)
+        following = self._block_start(block + 1)
         at = predicted + offset if following is None else min(predicted + offset, following)
         if at >= len(self.tool):
             return  # not predicted yet
@@ -136,11 +132,15 @@ class Predictor:
         self.off = distance > limit
 
     def _block_start(self, number: int) -> int | None:
-        for r in self._predicted("block"):
-            if r.get("number") == number:
+        """The first period of the prediction's block ``number`` (None: not reached)."""
+        records = [] if self.log is None else self.log.records
+        while self._scanned < len(records):
+            r = records[self._scanned]
+            self._scanned += 1
+            if r["kind"] == "block" and isinstance(r.get("number"), int):
                 t = r.get("t")
-                return round(t / PERIOD) if isinstance(t, int | float) else None
-        return None
+                self._starts[int(str(r["number"]))] = round(float(str(t)) / PERIOD)
+        return self._starts.get(number)
 
 
 def _int(value: object) -> int:

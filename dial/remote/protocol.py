@@ -18,6 +18,7 @@ MAX_MESSAGE = 1 << 20  # bytes: larger messages are refused ('too_large'), the l
 # What the WebSocket layer accepts at all: a larger frame closes the connection (1009).
 MAX_FRAME = 16 << 20
 DEFAULT_PORT = 8765
+CLOSE_S = 0.5  # s a closing handshake may take: a cut or dead peer never answers it
 
 # The error codes of an ``error`` message (docs/remote.md lists what each means).
 ERRORS = (

@@ -76,7 +76,9 @@ class Telemetry:
         arm = [round(float(x), 5) for x in d.qpos[ix.arm_qpos]]
         hand = [round(float(x), 5) for x in d.qpos[ix.hand_qpos]]
         t = round(periods * robot.period, 6)
+        block, since = self.session.block
         fields: dict[str, object] = {"tick": tick, "t": t, "tool": tool, "arm": arm, "hand": hand}
+        fields.update(block=block, since=periods - since)
         self.session.sample(encode("telemetry", periods=periods, **fields), fields)
 
 

@@ -23,6 +23,7 @@ import trio
 from trio_websocket import ConnectionClosed, WebSocketConnection, WebSocketRequest, serve_websocket
 
 from dial.remote.protocol import (
+    CLOSE_S,
     COMMANDS,
     MAX_FRAME,
     TO_ROBOT,
@@ -117,8 +118,9 @@ class Server:
         try:
             async with trio.open_nursery() as nursery:
                 nursery.start_soon(self._sender, conn)
-                while not conn.closing:
-                    await self._receive(conn, await conn.ws.get_message())
+                with contextlib.suppress(ConnectionClosed, trio.BrokenResourceError):
+                    while not conn.closing:
+                        await self._receive(conn, await conn.ws.get_message())
                 nursery.cancel_scope.cancel()
         except (ConnectionClosed, trio.BrokenResourceError):
             pass
@@ -126,7 +128,7 @@ class Server:
             self.conns.discard(conn)
             if self.controller is conn:
                 self.controller = None  # the session waits for its operator: the watchdog runs
-            with trio.CancelScope(shield=True):
+            with trio.CancelScope(shield=True), trio.move_on_after(CLOSE_S):
                 await conn.ws.aclose()
 
     async def _receive(self, conn: Conn, raw: str | bytes) -> None:
@@ -158,6 +160,7 @@ class Server:
     async def _send_all(self, conn: Conn) -> None:
         due = trio.current_time()
         while True:
+            conn.woken = trio.Event()  # before sending: a wake meanwhile is not lost
             s = conn.session
             if s is not None and conn is self.controller:
                 for report in s.reports_from(conn.sent):
@@ -169,7 +172,6 @@ class Server:
             if trio.current_time() >= due:
                 await conn.send(encode("heartbeat", tick=self._tick()))
                 due = trio.current_time() + self.heartbeat
-            conn.woken = trio.Event()
             with trio.move_on_at(due):
                 await conn.woken.wait()
 
@@ -218,7 +220,7 @@ class Server:
         old = self.controller
         if old is not None and old is not conn:
             old.closing = True  # the same operator again, after a cut its old socket missed
-            with trio.CancelScope(shield=True):
+            with trio.CancelScope(shield=True), trio.move_on_after(CLOSE_S):
                 await old.ws.aclose()
         conn.session, conn.sent = s, msg.integer("have")
         self.controller, self.last_heard = conn, trio.current_time()

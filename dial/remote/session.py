@@ -27,6 +27,8 @@ from dial.scheduler.signals import StopRequest
 
 # Record kinds that only the link writes: they hold wall times, and a comparison of a
 # remote robot's log with a local run's leaves them out (docs/remote.md).
+PERIOD = 0.01  # s, the control period
+
 LINK_RECORDS = frozenset(
     {"session", "received", "sent", "acknowledged", "reported", "late", "lost", "diverged"}
 )
@@ -50,6 +52,7 @@ class Session:
         self.thread: threading.Thread | None = None
         self.split: str | None = None  # "script" or "block", once the script is sent
         self.bandwidth: float | None = None  # bit/s the operator says its link has
+        self.block = (0, 0)  # the latest block the robot started: (number, its first period)
         self._pending: list[Record] = []
         self._lock = threading.Lock()
         self._log = log
@@ -58,6 +61,10 @@ class Session:
     # -- the robot's log: written to the server's file and streamed to the operator ----------
     def record(self, record: Record) -> None:
         """A log record, in order: to the log file and into the report stream."""
+        if record.get("kind") == "block":
+            number, t = record.get("number"), record.get("t")
+            if isinstance(number, int) and isinstance(t, int | float):
+                self.block = (number, round(t / PERIOD))
         with self._lock:
             if self._log is not None:
                 self._log.write(json.dumps(record, separators=(",", ":")) + "\n")

@@ -24,7 +24,7 @@ from dial.remote.protocol import Message
 if TYPE_CHECKING:
     from dial.remote.operator import Operator
 
-LEAD_MARGIN_S = 0.2  # s added to 1.5 round trips for the default lead
+LEAD_MARGIN_S = 0.1  # s added to 1.25 round trips for the default lead
 
 
 async def run_split(script: Script, op: Operator) -> None:
@@ -51,16 +51,13 @@ async def run_split(script: Script, op: Operator) -> None:
 
 
 def lead_ticks(op: Operator, rtt: float) -> int:
-    """``--lead`` in ticks of the robot's paced time; by default 1.5 round trips and a
-    margin, rounded up to a power of two ticks (so that runs whose round trips differ a
-    little tag the same ticks)."""
+    """``--lead`` in ticks of the robot's paced time; by default 1.25 round trips and a
+    margin (give ``--lead`` for runs that must tag the same ticks)."""
     pace = op.channel.robot.get("pace", 1.0)
     wall_per_tick = op.options.tick * (float(pace) if isinstance(pace, int | float) else 1.0)
     given = op.options.lead
-    seconds = given if given is not None else 1.5 * rtt + LEAD_MARGIN_S
+    seconds = given if given is not None else 1.25 * rtt + LEAD_MARGIN_S
     ticks = max(1, math.ceil(seconds / wall_per_tick))
-    if given is None:
-        ticks = 1 << (ticks - 1).bit_length()
     op.out.link("lead", seconds=round(seconds, 4), ticks=ticks)
     return ticks
 
@@ -136,29 +133,37 @@ class Walker:
         return seq
 
     async def _result(self, seq: int) -> Message:
+        """Wait for command ``seq``'s result; meanwhile, a command of the chain before it
+        refused ``late`` is sent again with those after it (``seq`` then names the copy)."""
         while True:
             seq = self.renamed.get(seq, seq)
-            result = await self.op.result_of(seq)
-            if result.type != "refused":
-                return result
-            code = result.text("code")
-            if code == "dropped" and seq in self.renamed:
+            refused = self._refused()
+            if refused is not None:
+                await self._resend(refused.integer("seq"), refused)
                 continue
-            if code != "late":
-                raise DialError(f"the robot refused command {seq}: {result.text('message')}")
-            await self._resend(seq, result)
+            result = self.op.results.get(seq)
+            if result is not None and result.type != "refused":
+                return result
+            await self.op.next_report()
+
+    def _refused(self) -> Message | None:
+        """The first command of the chain that the robot refused, if any."""
+        for old, *_ in self.chain:
+            result = self.op.results.get(old)
+            if result is not None and result.type == "refused":
+                if result.text("code") not in ("late", "dropped"):
+                    raise DialError(f"the robot refused command {old}: {result.text('message')}")
+                return result
+        return None
 
     async def _resend(self, seq: int, refused: Message) -> None:
         """Send the late command and those chained after it again, later by one lead more."""
         self.lead *= 2
-        at = [i for i, c in enumerate(self.chain) if c[0] == seq]
-        if not at:
-            raise DialError(f"the robot refused command {seq} as late, and it was not sent ahead")
-        again = self.chain[at[0] :]
+        at = next(i for i, c in enumerate(self.chain) if c[0] == seq)
+        again = self.chain[at:]
         shift = refused.integer("tick") + 1 + self.lead - again[0][2]
-        self.after = self.chain[at[0] - 1][0] if at[0] > 0 else again[0][0] - 1
-        self.after = refused.integer("after", self.after)
-        self.chain = self.chain[: at[0]]
+        self.after = refused.integer("after")  # the last command the robot ran
+        self.chain = self.chain[:at]
         for old, type_, tick, fields in again:
             new = await self.op.channel.command(
                 type_, tick=tick + shift, after=self.after, **fields
