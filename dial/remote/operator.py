@@ -16,7 +16,7 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TextIO
+from typing import TYPE_CHECKING, TextIO
 
 import trio
 
@@ -31,6 +31,9 @@ from dial.scheduler.log import EventLog, Record
 from dial.scheduler.runner import RunSummary
 from dial.scheduler.signals import StopRequest
 from dial.scheduler.types import RunAborted
+
+if TYPE_CHECKING:
+    from dial.remote.predict import Predictor
 
 Progress = Callable[[int, float, list[str]], None]
 STOP_WAIT_S = 1.0  # after the watchdog time, how long a stopped robot may take to report
@@ -91,7 +94,9 @@ class Operator:
         self.summary: Record | None = None
         self.rejected: str | None = None
         self.running: dict[tuple[str, int], str] = {}  # (event, line) -> event, for progress
-        self.predictor: object | None = None
+        # (script, event) -> the outcome of its latest run, as reported (what a condition reads)
+        self.latest: dict[tuple[str, str], str] = {}
+        self.predictor: Predictor | None = None
         self.channel = Channel(
             options.url,
             options.token,
@@ -137,21 +142,27 @@ class Operator:
         kind = record.get("kind")
         line = record.get("line")
         key = (str(record.get("event")), line if isinstance(line, int) else 0)
+        where = (str(record.get("script", self.script.path)), str(record.get("event")))
         if kind == "start":
             self.running[key] = str(record.get("event"))
         elif kind == "end":
             self.running.pop(key, None)
+            self.latest[where] = str(record.get("outcome"))
+        elif kind == "monitor":  # what a condition on the watched event sees afterwards
+            self.latest[where] = (
+                "missed" if str(record.get("condition")).startswith("!") else "done"
+            )
         elif kind == "tick" and self.options.progress is not None:
             t = record.get("t1")
             tick = record.get("tick")
             if isinstance(t, float | int) and isinstance(tick, int):
                 self.options.progress(tick, float(t), sorted(self.running.values()))
         if self.predictor is not None:
-            self.predictor.reported(record)  # type: ignore[attr-defined]
+            self.predictor.reported(record)
 
     def _telemetry(self, msg: Message) -> None:
         if self.predictor is not None:
-            self.predictor.telemetry(msg)  # type: ignore[attr-defined]
+            self.predictor.telemetry(msg)
 
     async def result_of(self, seq: int) -> Message:
         """Wait for the robot's result (or refusal) of command ``seq``."""
@@ -266,6 +277,8 @@ async def operate(script: Script, options: OperatorOptions, stop: StopRequest) -
         op.channel.done = True
         nursery.cancel_scope.cancel()
     wall = time.perf_counter() - start
+    if op.predictor is not None:
+        op.predictor.halt()
     if op.channel.lost is not None and op.finished is None:
         message = op.channel.lost
         op.out.link("lost", message=message)

@@ -22,6 +22,7 @@ from dial.engine.result import RunResult
 from dial.parser.script import Script
 from dial.remote.protocol import Message
 from dial.scheduler.log import EventLog, Record
+from dial.scheduler.signals import StopRequest
 
 if TYPE_CHECKING:
     from dial.remote.operator import Operator
@@ -39,6 +40,8 @@ class Predictor:
         self.tool: list[tuple[float, float, float]] = []  # mm, per control period from 0
         self.log: EventLog | None = None
         self.done = threading.Event()
+        self.stop = StopRequest()  # the operator's run is over: the prediction stops too
+        self.thread: threading.Thread | None = None
         self.error: str | None = None
         self.seen: dict[tuple[str, str, int], int] = defaultdict(int)  # reported ends, monitors
         self.off = False  # the tool is away from the prediction now
@@ -131,6 +134,13 @@ class Predictor:
             )
         self.off = distance > limit
 
+    def halt(self) -> None:
+        """Stop the predicted run at its next control period and wait for its thread (a
+        thread left in MuJoCo while Python exits would crash it)."""
+        self.stop.request("the remote run ended")
+        if self.thread is not None:
+            self.thread.join(timeout=10.0)
+
     def _block_start(self, number: int) -> int | None:
         """The first period of the prediction's block ``number`` (None: not reached)."""
         records = [] if self.log is None else self.log.records
@@ -156,11 +166,13 @@ async def start_prediction(script: Script, op: Operator) -> Predictor:
         from dial.engine.run import run as run_engine
 
         try:
-            run_engine(script, RunOptions(tick=op.options.tick, observers=[predictor]))
+            options = RunOptions(tick=op.options.tick, observers=[predictor], stop=predictor.stop)
+            run_engine(script, options)
         except Exception as e:  # the prediction is advice: the remote run goes on without it
             predictor.error = str(e)
         finally:
             predictor.done.set()
 
-    threading.Thread(target=predict, daemon=True, name="dial-prediction").start()
+    predictor.thread = threading.Thread(target=predict, daemon=True, name="dial-prediction")
+    predictor.thread.start()
     return predictor

@@ -13,6 +13,7 @@ it, ``lead`` ticks after the robot's tick, and the lead doubles.
 
 from __future__ import annotations
 
+import json
 import math
 from typing import TYPE_CHECKING
 
@@ -107,11 +108,33 @@ class Walker:
         )
 
     async def test(self, script: Script, step: TIf | TRepeat) -> bool:
-        """A condition, tested at the robot at its tick: wait for its value."""
+        """A condition, tested at the robot at its tick. Its value is known here when the
+        robot has reported its event's latest outcome and no command on its way can change
+        it: then the walk goes on at once; else it waits for the robot's value."""
+        known = self._known(script, step)
         seq = await self._send(
-            "test", None, script=script.path, line=step.line, condition=str(step.condition)
+            "test",
+            None if known is None else 0,
+            script=script.path,
+            line=step.line,
+            condition=str(step.condition),
         )
+        if known is not None:
+            return known
         return (await self._result(seq)).fields.get("value") is True
+
+    def _known(self, script: Script, step: TIf | TRepeat) -> bool | None:
+        cond = step.condition
+        assert cond is not None
+        if cond.event in script.condition_only:
+            return None  # sensed at the robot, now
+        mention = json.dumps(cond.event)
+        for seq, type_, _, fields in self.chain:
+            on_its_way = seq not in self.op.results and type_ == "block"
+            if on_its_way and mention in json.dumps(fields.get("block")):
+                return None  # a block on its way runs or watches the event
+        outcome = self.op.latest.get((script.path, cond.event))
+        return (outcome == "done") != cond.negated
 
     async def end(self, error: str | None) -> None:
         await self._send("end", 0, **({} if error is None else {"error": error}))

@@ -14,7 +14,7 @@ import subprocess
 import sys
 import time
 from collections.abc import Iterator
-from contextlib import contextmanager
+from contextlib import contextmanager, suppress
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -60,14 +60,10 @@ class Server:
 
 def _kill(proc: subprocess.Popen[str]) -> None:
     if proc.poll() is None:
-        try:
+        with suppress(ProcessLookupError):
             os.killpg(proc.pid, signal.SIGKILL)
-        except ProcessLookupError:
-            pass
-    try:
+    with suppress(subprocess.TimeoutExpired):
         proc.wait(timeout=10)
-    except subprocess.TimeoutExpired:
-        pass
 
 
 @contextmanager
@@ -105,9 +101,9 @@ def server(folder: Path, *args: str, pace: float = 0.1) -> Iterator[Server]:
 
 
 @contextmanager
-def operator(srv: Server, script: str, *args: str, log: Path | None = None) -> Iterator[
-    subprocess.Popen[str]
-]:
+def operator(
+    srv: Server, script: str, *args: str, log: Path | None = None
+) -> Iterator[subprocess.Popen[str]]:
     """``dial run SCRIPT --remote`` started (not waited for), killed at the end."""
     argv = dial(
         "run", script, "--remote", srv.url, "--token-file", str(srv.token_file), "--json", *args
