@@ -10,7 +10,6 @@ import argparse
 import ipaddress
 import math
 import sys
-from pathlib import Path
 
 from dial.cli.common import UsageError, scene_argument
 
@@ -27,6 +26,12 @@ def listen_address(text: str, flag: str = "--listen") -> tuple[str, int]:
 
 
 def add_parsers(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
+    add_parser(sub)
+    _link_parser(sub)
+
+
+def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
+    """``dial serve``."""
     p = sub.add_parser(
         "serve",
         help="be the robot: run what a remote operator sends (docs/remote.md)",
@@ -86,6 +91,8 @@ def add_parsers(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> Non
     )
     p.set_defaults(func=cmd_serve)
 
+
+def _link_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     q = sub.add_parser(
         "link",
         help="an emulated link between a client and a server (delay, cuts...)",
@@ -205,12 +212,6 @@ def check_remote(args: argparse.Namespace) -> None:
         raise UsageError(f"--lead must be above 0 s, got {args.lead:g}")
     if not (math.isfinite(args.diverge) and args.diverge > 0):
         raise UsageError(f"--diverge must be above 0 mm, got {args.diverge:g}")
-
-
-def token_path(args: argparse.Namespace) -> Path:
-    from dial.remote.tokens import default_token_file
-
-    return Path(args.token_file) if args.token_file else default_token_file()
 
 
 def say(text: str) -> None:

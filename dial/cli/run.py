@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING
 from dial import api
 from dial.cli.common import UsageError, load_script, scene_argument
 from dial.cli.remote import add_run_options, check_remote
+from dial.parser.script import Script
 from dial.recording.timeline import qualified_event
 from dial.scheduler.signals import EXIT_STATUS, StopRequest, catch_stop_signals
 
@@ -119,6 +120,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     # From here to the exit, a stop signal stops the run (which catches it first) or, once
     # the run is over, is ignored: a second Ctrl-C cannot cut the summary or the log short.
     stop = StopRequest()
+    check_remote(args)
     with catch_stop_signals(stop):
         return _run(args, stop)
 
@@ -127,16 +129,13 @@ def _run(args: argparse.Namespace, stop: StopRequest) -> int:
     if args.log_states and not args.log:
         raise UsageError("--log-states writes into the log: give --log FILE.jsonl too")
     api.check_options(args.tick, args.speed, args.seed, args.perturb)
-    check_remote(args)
     save_at = _save_at(args.save_at)
     script = load_script(args.script, args.scene)
     if stop.signal is not None:  # while the script was being checked
         print(f"dial: interrupted by {stop.signal}", file=sys.stderr)
         return EXIT_STATUS[stop.signal]
     if args.remote is not None:
-        from dial.cli.run_remote import run_remote
-
-        return run_remote(args, script, stop, _progress(args.quiet), summary_text)
+        return _remote(args, script, stop)
     result = api.run(
         script,
         tick=args.tick,
@@ -186,6 +185,12 @@ def _run(args: argparse.Namespace, stop: StopRequest) -> int:
         )
         return 1
     return 0 if result.ok else 1
+
+
+def _remote(args: argparse.Namespace, script: Script, stop: StopRequest) -> int:
+    from dial.cli.run_remote import run_remote
+
+    return run_remote(args, script, stop, _progress(args.quiet), summary_text)
 
 
 def _save_at(value: list[str] | None) -> tuple[int, str] | None:

@@ -42,8 +42,8 @@ from dial.parser.script import (
 )
 from dial.primitives import make_factory
 from dial.remote.protocol import Message
-from dial.remote.robot import RobotConfig, Telemetry, _disturbances
 from dial.remote.session import Session
+from dial.remote.telemetry import RobotConfig, Telemetry, disturbances
 from dial.scheduler.log import EventLog, clean
 from dial.scheduler.position import Frame, Path
 from dial.scheduler.runner import Runner
@@ -238,7 +238,7 @@ def run_blocks(
     from dial.remote.session import Tee
 
     log = EventLog(Tee(session))
-    disturb = _disturbances(config.disturb)
+    disturb = disturbances(config.disturb)
     robot, ctx = prepare(script, log, config.perturb, config.seed, disturb)
     telemetry.begin(Watched(robot, ctx.world, log))
     runner = BlockRunner(

@@ -11,49 +11,28 @@ summary and criteria. It predicts the robot on its own believed world
 from __future__ import annotations
 
 import json
-import os
 import time
-from collections.abc import Callable
-from dataclasses import dataclass, field
-from pathlib import Path
-from typing import TYPE_CHECKING, TextIO
+from dataclasses import dataclass
+from typing import TextIO
 
 import trio
 
 from dial.engine.result import Criteria, RunResult
 from dial.errors import DialError
-from dial.parser.script import Script, scripts_of
+from dial.parser.script import Script
 from dial.remote.channel import Channel
-from dial.remote.link import Link, LinkSpec, serve_link
+from dial.remote.link import Link, serve_link
+from dial.remote.options import OperatorOptions
+from dial.remote.predict import Predictor, start_prediction
 from dial.remote.protocol import Message
+from dial.remote.walk import run_split
 from dial.scene.of_script import script_world
 from dial.scheduler.log import EventLog, Record
 from dial.scheduler.runner import RunSummary
 from dial.scheduler.signals import StopRequest
 from dial.scheduler.types import RunAborted
 
-if TYPE_CHECKING:
-    from dial.remote.predict import Predictor
-
-Progress = Callable[[int, float, list[str]], None]
 STOP_WAIT_S = 1.0  # after the watchdog time, how long a stopped robot may take to report
-
-
-@dataclass
-class OperatorOptions:
-    """``dial run --remote``'s options."""
-
-    url: str
-    token: str
-    split: str = "script"
-    link: LinkSpec | None = None
-    lead: float | None = None  # s; None: from the round trip measured at connect
-    diverge_mm: float = 10.0
-    tick: float = 0.25  # the run's tick length, s
-    log: TextIO | None = None
-    progress: Progress | None = None
-    predict: bool = True
-    observers: list[object] = field(default_factory=list)
 
 
 @dataclass
@@ -105,6 +84,10 @@ class Operator:
             self.out.link,
             None if options.link is None else options.link.bandwidth,
         )
+
+    def link(self, kind: str, /, **fields: object) -> None:
+        """A link record in the operator's log."""
+        self.out.link(kind, **fields)
 
     # -- reports ---------------------------------------------------------------------------------
     def _report(self, msg: Message) -> None:
@@ -185,18 +168,6 @@ class Operator:
 
 class _Finished(Exception):
     """The robot's run ended before the walk did (an abort at the robot, a stop)."""
-
-
-def upload(script: Script) -> dict[str, object]:
-    """The script and every script it calls, as files relative to the script's folder."""
-    base = Path(script.path).parent
-    files: dict[str, str] = {}
-    for s in scripts_of(script):
-        name = os.path.relpath(s.path, base).replace(os.sep, "/")
-        if name.startswith(".."):
-            raise DialError(f"'{s.path}' lies outside the script's folder: it cannot be sent")
-        files[name] = Path(s.path).read_text(encoding="utf-8")
-    return {"path": script.path, "main": Path(script.path).name, "files": files}
 
 
 def remote_result(script: Script, op: Operator, wall: float) -> RunResult | None:
@@ -289,13 +260,10 @@ async def operate(script: Script, options: OperatorOptions, stop: StopRequest) -
 
 
 async def _session(script: Script, op: Operator) -> str | None:
-    from dial.remote.walk import run_split
-
+    options = op.options
     await op.channel.wait_welcome()
     if op.options.predict:
-        from dial.remote.predict import start_prediction
-
-        op.predictor = await start_prediction(script, op)
+        op.predictor = start_prediction(script, options.tick, op.link, options.diverge_mm)
     try:
         await run_split(script, op)
         await op.wait_finished()

@@ -15,7 +15,7 @@ from __future__ import annotations
 import math
 import threading
 from collections import defaultdict
-from typing import TYPE_CHECKING
+from collections.abc import Callable
 
 from dial.engine.observe import Watched
 from dial.engine.result import RunResult
@@ -23,9 +23,6 @@ from dial.parser.script import Script
 from dial.remote.protocol import Message
 from dial.scheduler.log import EventLog, Record
 from dial.scheduler.signals import StopRequest
-
-if TYPE_CHECKING:
-    from dial.remote.operator import Operator
 
 PERIOD = 0.01  # s, the control period (both sides)
 
@@ -35,8 +32,8 @@ class Predictor:
 
     what = "the prediction"
 
-    def __init__(self, op: Operator) -> None:
-        self.op = op
+    def __init__(self, write: Callable[..., None], diverge_mm: float) -> None:
+        self.write, self.diverge_mm = write, diverge_mm  # write(kind, **fields): a link record
         self.tool: list[tuple[float, float, float]] = []  # mm, per control period from 0
         self.log: EventLog | None = None
         self.done = threading.Event()
@@ -95,7 +92,7 @@ class Predictor:
         predicted = same[k].get("outcome", "fired") if k < len(same) else "nothing"
         reported = record.get("outcome", "fired")
         if predicted != reported:
-            self.op.out.link(
+            self.write(
                 "diverged",
                 what="outcome" if kind == "end" else "monitor",
                 event=key[1],
@@ -120,10 +117,10 @@ class Predictor:
         if len(tool) != 3:
             return
         distance = math.dist(tool, self.tool[at])
-        limit = self.op.options.diverge_mm
+        limit = self.diverge_mm
         if distance > limit and not self.off:
             events = sorted(set(self.running.values()))
-            self.op.out.link(
+            self.write(
                 "diverged",
                 what="tool",
                 event=", ".join(events) if events else None,
@@ -157,16 +154,18 @@ def _int(value: object) -> int:
     return value if isinstance(value, int) else 0
 
 
-async def start_prediction(script: Script, op: Operator) -> Predictor:
+def start_prediction(
+    script: Script, tick: float, write: Callable[..., None], diverge_mm: float
+) -> Predictor:
     """Start the predicted run in a thread; the predictor compares as reports arrive."""
-    predictor = Predictor(op)
+    predictor = Predictor(write, diverge_mm)
 
     def predict() -> None:
         from dial.engine.run import RunOptions
         from dial.engine.run import run as run_engine
 
         try:
-            options = RunOptions(tick=op.options.tick, observers=[predictor], stop=predictor.stop)
+            options = RunOptions(tick=tick, observers=[predictor], stop=predictor.stop)
             run_engine(script, options)
         except Exception as e:  # the prediction is advice: the remote run goes on without it
             predictor.error = str(e)

@@ -11,23 +11,20 @@ time (then the simulation parks), or until the next session resets the scene.
 
 from __future__ import annotations
 
-import math
 import posixpath
 import tempfile
 import time
-from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from collections.abc import Mapping
 from pathlib import Path
 
-from dial.backend.driver import MujocoRobot
-from dial.disturb import Disturbance, parse_disturbance
-from dial.engine.observe import Watched
 from dial.engine.result import RunResult
 from dial.errors import DialError, ScriptError
 from dial.parser.check import load as check_file
 from dial.parser.script import Script
-from dial.remote.protocol import Message, encode
+from dial.remote.blocks import run_blocks
+from dial.remote.protocol import Message
 from dial.remote.session import Session, Tee
+from dial.remote.telemetry import RobotConfig, Telemetry, disturbances
 from dial.scene import load_scene_names
 from dial.scene.resolve import scene_option
 
@@ -35,59 +32,6 @@ HOLD_S = 5.0  # wall s the held robot is simulated after a run ends; then it par
 SAMPLE_BYTES = 420  # about the size of one telemetry message
 TELEMETRY_EVERY = 10  # control periods between samples at most (0.1 s of simulated time)
 MAX_FILES = 64
-
-
-@dataclass(frozen=True)
-class RobotConfig:
-    """The robot's own settings (``dial serve``'s options)."""
-
-    scene: str | None
-    perturb: float
-    seed: int
-    disturb: tuple[str, ...]
-    pace: float
-    watchdog: float
-
-
-class Telemetry:
-    """An observer: the robot's state every few control periods, as a telemetry sample."""
-
-    what = "telemetry"
-
-    def __init__(self, session: Session, every: int) -> None:
-        self.session, self.every = session, every
-        self.robot: MujocoRobot | None = None
-
-    def begin(self, run: Watched) -> None:
-        self.robot = run.robot
-
-    def period(self, periods: int, tick: int) -> None:
-        if periods % self.every == 0:
-            self.sample(periods, tick)
-
-    def end(self, result: RunResult | None) -> None:
-        pass
-
-    def sample(self, periods: int, tick: int) -> None:
-        robot = self.robot
-        assert robot is not None
-        d, ix = robot.data, robot.index
-        tool = [round(float(x) * 1000.0, 2) for x in d.site_xpos[ix.tool_site]]
-        arm = [round(float(x), 5) for x in d.qpos[ix.arm_qpos]]
-        hand = [round(float(x), 5) for x in d.qpos[ix.hand_qpos]]
-        t = round(periods * robot.period, 6)
-        block, since = self.session.block
-        fields: dict[str, object] = {"tick": tick, "t": t, "tool": tool, "arm": arm, "hand": hand}
-        fields.update(block=block, since=periods - since)
-        self.session.sample(encode("telemetry", periods=periods, **fields), fields)
-
-
-def telemetry_every(period: float, pace: float, bandwidth: float | None) -> int:
-    """Control periods between telemetry samples: at most half the link's bandwidth."""
-    if bandwidth is None:
-        return TELEMETRY_EVERY
-    wall = 2.0 * SAMPLE_BYTES * 8.0 / bandwidth  # s of wall time between samples, at least
-    return max(TELEMETRY_EVERY, math.ceil(wall / (period * pace)))
 
 
 def checked_upload(upload: Mapping[str, object], scene: str | None, folder: Path) -> Script:
@@ -163,21 +107,14 @@ def _run(
             tick=tick,
             seed=config.seed,
             perturb_mm=config.perturb,
-            disturb=_disturbances(config.disturb),
+            disturb=disturbances(config.disturb),
             log=Tee(session),
             observers=[telemetry],
             pace=config.pace,
             stop=session.stop,
         )
         return run_engine(script, options)
-    from dial.remote.blocks import run_blocks
-
     return run_blocks(session, config, script, first, telemetry)
-
-
-def _disturbances(texts: Sequence[str]) -> list[Disturbance]:
-
-    return [parse_disturbance(t) for t in texts]
 
 
 def hold(session: Session, telemetry: Telemetry, pace: float) -> None:

@@ -13,9 +13,10 @@ import trio
 from dial.errors import DialError
 from dial.parser.script import Script
 from dial.remote.link import Link, LinkSpec, parse_link, serve_link
-from dial.remote.operator import OperatorOptions, Progress, RemoteResult, operate
-from dial.remote.robot import RobotConfig
+from dial.remote.operator import RemoteResult, operate
+from dial.remote.options import OperatorOptions, Progress
 from dial.remote.server import Server
+from dial.remote.telemetry import RobotConfig
 from dial.remote.tokens import default_token_file, ensure_token, read_token
 from dial.scheduler.signals import StopRequest
 
@@ -93,11 +94,9 @@ def run_remote(
     progress: Progress | None,
 ) -> RemoteResult:
     """``dial run --remote``: the operator's run."""
-    from dial.cli.remote import token_path
-
     options = OperatorOptions(
         url=args.remote,
-        token=read_token(token_path(args)),
+        token=read_token(Path(args.token_file) if args.token_file else default_token_file()),
         split=args.split,
         link=None if args.link is None else parse_link(args.link),
         lead=args.lead,

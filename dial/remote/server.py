@@ -34,8 +34,9 @@ from dial.remote.protocol import (
     encode,
     error,
 )
-from dial.remote.robot import RobotConfig, robot_main, telemetry_every
+from dial.remote.robot import robot_main
 from dial.remote.session import Session
+from dial.remote.telemetry import RobotConfig, telemetry_every
 from dial.remote.tokens import same_token
 
 

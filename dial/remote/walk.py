@@ -15,26 +15,41 @@ from __future__ import annotations
 
 import json
 import math
-from typing import TYPE_CHECKING
+import os
+from pathlib import Path
+from typing import Protocol
 
 from dial.errors import DialError
-from dial.parser.script import Script, Step, TBlock, TCall, TIf, TRepeat
+from dial.parser.script import Script, Step, TBlock, TCall, TIf, TRepeat, scripts_of
 from dial.remote.blocks import describe
+from dial.remote.channel import Channel
+from dial.remote.options import OperatorOptions
 from dial.remote.protocol import Message
 
-if TYPE_CHECKING:
-    from dial.remote.operator import Operator
+
+class Station(Protocol):
+    """What the walk needs of the operator: the channel, the options, the reports."""
+
+    channel: Channel
+    options: OperatorOptions
+    results: dict[int, Message]  # by command seq: each command's result or refusal
+    latest: dict[tuple[str, str], str]  # (script, event) -> its latest outcome, reported
+
+    def link(self, kind: str, /, **fields: object) -> None: ...
+
+    async def result_of(self, seq: int) -> Message: ...
+
+    async def next_report(self) -> None: ...
+
 
 LEAD_MARGIN_S = 0.1  # s added to 1.25 round trips for the default lead
 
 
-async def run_split(script: Script, op: Operator) -> None:
+async def run_split(script: Script, op: Station) -> None:
     """Send the script whole, or open a block session and walk its timeline."""
-    from dial.remote.operator import upload
-
     ch, tick = op.channel, op.options.tick
     rtt = await ch.measure_rtt()
-    op.out.link("rtt", seconds=round(rtt, 4))
+    op.link("rtt", seconds=round(rtt, 4))
     if op.options.split == "script":
         seq = await ch.command("run", tick=1, after=0, script=upload(script), tick_length=tick)
         await op.result_of(seq)
@@ -51,7 +66,7 @@ async def run_split(script: Script, op: Operator) -> None:
     await walker.end(None)
 
 
-def lead_ticks(op: Operator, rtt: float) -> int:
+def lead_ticks(op: Station, rtt: float) -> int:
     """``--lead`` in ticks of the robot's paced time; by default 1.25 round trips and a
     margin (give ``--lead`` for runs that must tag the same ticks)."""
     pace = op.channel.robot.get("pace", 1.0)
@@ -59,8 +74,20 @@ def lead_ticks(op: Operator, rtt: float) -> int:
     given = op.options.lead
     seconds = given if given is not None else 1.25 * rtt + LEAD_MARGIN_S
     ticks = max(1, math.ceil(seconds / wall_per_tick))
-    op.out.link("lead", seconds=round(seconds, 4), ticks=ticks)
+    op.link("lead", seconds=round(seconds, 4), ticks=ticks)
     return ticks
+
+
+def upload(script: Script) -> dict[str, object]:
+    """The script and every script it calls, as files relative to the script's folder."""
+    base = Path(script.path).parent
+    files: dict[str, str] = {}
+    for s in scripts_of(script):
+        name = os.path.relpath(s.path, base).replace(os.sep, "/")
+        if name.startswith(".."):
+            raise DialError(f"'{s.path}' lies outside the script's folder: it cannot be sent")
+        files[name] = Path(s.path).read_text(encoding="utf-8")
+    return {"path": script.path, "main": Path(script.path).name, "files": files}
 
 
 class _Max(Exception):
@@ -70,7 +97,7 @@ class _Max(Exception):
 class Walker:
     """The operator's walk of a timeline, as commands tagged with ticks."""
 
-    def __init__(self, op: Operator, after: int, lead: int) -> None:
+    def __init__(self, op: Station, after: int, lead: int) -> None:
         self.op, self.after, self.lead = op, after, lead
         self.next = 1  # the tick the next command starts at, unless it waits on a result
         self.waiting: int | None = None  # the command whose result tells the next tick

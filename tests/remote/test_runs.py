@@ -80,7 +80,9 @@ def test_split_block_is_deterministic_and_a_server_serves_again(tmp_path: Path) 
         first, second = robot_log(srv.records(), 1), robot_log(srv.records(), 2)
     assert first == second
     kinds = [r["kind"] for r in first]
-    assert kinds.count("block") == 2 and "monitor" in kinds and kinds[-1] == "summary"
+    assert (
+        kinds.count("block") == 3 and "monitor" in kinds
+    )  # with the reaction's and kinds[-1] == "summary"
 
 
 def test_a_cut_in_a_block_is_followed_by_a_reconnect_and_each_block_runs_once(
@@ -116,9 +118,9 @@ def test_a_cut_in_a_block_is_followed_by_a_reconnect_and_each_block_runs_once(
 
 
 def test_a_push_at_the_robot_diverges_from_the_prediction(tmp_path: Path) -> None:
-    push = "push body=hand_base force=0,300,0 at=3 for=0.3"
-    with server(tmp_path, "--disturb", push, pace=0.2) as srv:
-        run_operator(srv, "pour.dial", log=tmp_path / "op.jsonl")
+    push = "push body=hand_base force=0,300,0 at=0.5 for=0.3"
+    with server(tmp_path, "--disturb", push, pace=0.5) as srv:
+        run_operator(srv, "reactions.dial", log=tmp_path / "op.jsonl")
     op = [json.loads(line) for line in (tmp_path / "op.jsonl").read_text().splitlines()]
     begin = next(r for r in op if r["kind"] == "disturb" and r["phase"] == "begin")
     tool = [r for r in op if r["kind"] == "diverged" and r["what"] == "tool"]
