@@ -29,12 +29,13 @@ from dial.parser.script import (
     TResume,
     TRetry,
 )
+from dial.robot.protocol import Clocked
 from dial.scheduler.log import EventLog
 from dial.scheduler.position import Frame, Hooks, Path, Resume
 from dial.scheduler.records import Records
 from dial.scheduler.signals import StopRequest, catch_stop_signals
 from dial.scheduler.ticks import Observe, Progress, TickLoop
-from dial.scheduler.types import Interrupted, Outcome, PrimitiveFactory, Robot, RunAborted, S
+from dial.scheduler.types import Interrupted, Outcome, PrimitiveFactory, RunAborted, S
 
 Ending = TResume | TRetry | TAbort  # how a reaction ends, once one of these is executed
 
@@ -69,7 +70,7 @@ class Runner(Generic[S]):
 
     def __init__(
         self,
-        robot: Robot[S],
+        robot: Clocked[S],
         factory: PrimitiveFactory[S],
         tick: float,
         log: EventLog | None = None,
