@@ -21,7 +21,6 @@ import time
 
 import trio
 
-from dial.backend.snapshot import Snapshot
 from dial.engine.observe import Watched, fan_out
 from dial.engine.result import RunResult, measure_criteria
 from dial.engine.setup import prepare
@@ -44,6 +43,7 @@ from dial.primitives import make_factory
 from dial.remote.protocol import Message
 from dial.remote.session import Session
 from dial.remote.telemetry import RobotConfig, Telemetry, disturbances
+from dial.robot.snapshot import Snapshot
 from dial.scheduler.log import EventLog, clean
 from dial.scheduler.position import Frame, Path
 from dial.scheduler.runner import Runner
