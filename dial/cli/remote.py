@@ -201,13 +201,20 @@ def check_remote(args: argparse.Namespace) -> None:
         "--save-at": args.save_at,
         "--resume": args.resume,
         "--realtime": args.realtime,
+        "--record": args.record,  # not yet: the predicted and reported robots together
+        "--rerun": args.rerun,
     }
     given = [flag for flag, value in local.items() if value]
     if given:
         raise UsageError(
             f"{', '.join(given)}: not with --remote (the robot's world is perturbed and "
-            "disturbed at 'dial serve'; a remote run is paced by the robot)"
+            "disturbed at 'dial serve'; a remote run is paced by the robot; a recording of "
+            "the predicted and the reported robot is not done yet)"
         )
+    if args.link is not None:
+        from dial.remote.link import parse_link  # a usage error before anything connects
+
+        parse_link(args.link)
     if args.lead is not None and not (math.isfinite(args.lead) and args.lead > 0):
         raise UsageError(f"--lead must be above 0 s, got {args.lead:g}")
     if not (math.isfinite(args.diverge) and args.diverge > 0):

@@ -181,7 +181,9 @@ class Channel:
         while not self.done and self.lost is None:
             limit = self.watchdog if self._welcome.is_set() else CONNECT_S
             silent = trio.current_time() - self._heard
-            if silent > limit:
+            if silent > limit and not self._welcome.is_set():
+                self.lost = f"no robot answered at {self.url} within {CONNECT_S:g} s"
+            elif silent > limit:
                 self.lost = f"lost the robot at {self.url}: no message for {silent:.1f} s"
             await trio.sleep(0.02)
         scope.cancel()
