@@ -49,6 +49,7 @@ class Channel:
     on_telemetry: Callable[[Message], None]
     link_record: Callable[..., None]  # (kind, **fields): a link record in the operator's log
     bandwidth: float | None = None
+    shown: str = ""  # the robot's URL as messages name it (``url`` may be a local link's)
     session: int | None = None
     robot: dict[str, object] = field(default_factory=dict)
     have: int = 0  # reports received
@@ -182,9 +183,10 @@ class Channel:
             limit = self.watchdog if self._welcome.is_set() else CONNECT_S
             silent = trio.current_time() - self._heard
             if silent > limit and not self._welcome.is_set():
-                self.lost = f"no robot answered at {self.url} within {CONNECT_S:g} s"
+                self.lost = f"no robot answered at {self.shown or self.url} within {CONNECT_S:g} s"
             elif silent > limit:
-                self.lost = f"lost the robot at {self.url}: no message for {silent:.1f} s"
+                where = self.shown or self.url
+                self.lost = f"lost the robot at {where}: no message for {silent:.1f} s"
             await trio.sleep(0.02)
         scope.cancel()
 

@@ -240,7 +240,7 @@ async def operate(script: Script, options: OperatorOptions, stop: StopRequest) -
         if options.link is not None:
             link = Link(options.link, options.url)
             port = await nursery.start(serve_link, link, "127.0.0.1", 0)
-            op.channel.url = f"ws://127.0.0.1:{port}/"
+            op.channel.url, op.channel.shown = f"ws://127.0.0.1:{port}/", options.url
         with trio.CancelScope() as work:
             nursery.start_soon(op.channel.run, work)
             nursery.start_soon(_watch_stop, op, stop, work)
