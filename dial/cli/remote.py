@@ -163,6 +163,12 @@ def cmd_serve(args: argparse.Namespace) -> int:
     except DialError as e:
         raise UsageError(str(e)) from None
     scene = None if args.scene is None else scene_option(args.scene)
+    if not is_loopback(host):
+        print(
+            f"dial serve: listening beyond loopback on {host}: whoever reaches it with the "
+            "token runs the robot",
+            file=sys.stderr,
+        )
     from dial.remote.serve import serve
 
     return serve(args, host, port, scene)
@@ -219,10 +225,6 @@ def check_remote(args: argparse.Namespace) -> None:
         raise UsageError(f"--lead must be above 0 s, got {args.lead:g}")
     if not (math.isfinite(args.diverge) and args.diverge > 0):
         raise UsageError(f"--diverge must be above 0 mm, got {args.diverge:g}")
-
-
-def say(text: str) -> None:
-    print(text, file=sys.stderr, flush=True)
 
 
 def is_loopback(host: str) -> bool:

@@ -110,7 +110,7 @@ def test_ctrl_c_at_the_operator_stops_the_robot(tmp_path: Path) -> None:
 def test_bad_input_gets_the_documented_errors_and_the_server_keeps_serving(
     tmp_path: Path,
 ) -> None:
-    with server(tmp_path, pace=0.2) as srv:
+    with server(tmp_path, "--scene", "reactions", pace=0.2) as srv:
         token = srv.token_file.read_text().strip()
         with websockets.connect(srv.url) as ws:  # a wrong token: refused, closed
             ws.send(json.dumps({"v": 1, "type": "hello", "token": "nope", "role": "operator"}))
