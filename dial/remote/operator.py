@@ -253,6 +253,8 @@ async def operate(script: Script, options: OperatorOptions, stop: StopRequest) -
     if op.channel.lost is not None and op.finished is None:
         message = op.channel.lost
         op.out.link("lost", message=message)
+    if message is None and op.summary is not None and op.summary.get("interrupted") == "link lost":
+        message = f"the robot lost the link at tick {op.summary.get('ticks')}: it holds"
     record = summary_record(op, wall)
     op.out.log.write("summary", **record)
     result = remote_result(script, op, wall)

@@ -214,9 +214,9 @@ class Server:
 
     async def _resume(self, conn: Conn, msg: Message) -> bool:
         s, number = self.session, msg.integer("session")
-        if s is None or s.number != number or not s.active:
-            state = "unknown" if s is None or s.number != number else s.state
-            await self._close(conn, "no_session", f"session {number} is over ({state})")
+        if s is None or s.number != number:  # the latest session, even over: its reports
+            why = f"session {number} is over: the robot has served another since"
+            await self._close(conn, "no_session", why)
             return False
         old = self.controller
         if old is not None and old is not conn:
