@@ -130,7 +130,7 @@ def add_run_options(p: argparse.ArgumentParser) -> None:
         type=float,
         metavar="S",
         help="--split block: tag a block that waited for a report S s of robot time ahead "
-        "(default: 1.5 round trips measured at connect and 0.2 s)",
+        "(default: 1.5 round trips measured at connect, and 0.2 s)",
     )
     g.add_argument(
         "--diverge",

@@ -26,9 +26,11 @@ def run_remote(
     summary_text: Callable[[RunResult], str],
 ) -> int:
     """Run at the robot; print the summary and criteria it reports; the exit status."""
+    from dial.cli import common
     from dial.engine.run import RunOptions, tick_length
     from dial.remote.serve import run_remote as operate
 
+    common.EXIT_AT_ONCE = True  # the program's main() ends the process at once afterwards
     tick = tick_length(script, RunOptions(tick=args.tick, speed=args.speed))
     with log_sink(args.log) as sink:
         remote = operate(args, script, tick, sink, stop, progress)

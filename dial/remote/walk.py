@@ -42,7 +42,7 @@ class Station(Protocol):
     async def next_report(self) -> None: ...
 
 
-LEAD_MARGIN_S = 0.1  # s added to 1.25 round trips for the default lead
+LEAD_MARGIN_S = 0.2  # s added to 1.5 round trips for the default lead
 
 
 async def run_split(script: Script, op: Station) -> None:
@@ -67,12 +67,12 @@ async def run_split(script: Script, op: Station) -> None:
 
 
 def lead_ticks(op: Station, rtt: float) -> int:
-    """``--lead`` in ticks of the robot's paced time; by default 1.25 round trips and a
+    """``--lead`` in ticks of the robot's paced time; by default 1.5 round trips and a
     margin (give ``--lead`` for runs that must tag the same ticks)."""
     pace = op.channel.robot.get("pace", 1.0)
     wall_per_tick = op.options.tick * (float(pace) if isinstance(pace, int | float) else 1.0)
     given = op.options.lead
-    seconds = given if given is not None else 1.25 * rtt + LEAD_MARGIN_S
+    seconds = given if given is not None else 1.5 * rtt + LEAD_MARGIN_S
     ticks = max(1, math.ceil(seconds / wall_per_tick))
     op.link("lead", seconds=round(seconds, 4), ticks=ticks)
     return ticks
