@@ -130,15 +130,16 @@ class BlockRunner(Runner[Snapshot]):
         await self._first(loop)
         while True:
             command = self._next()
+            if command is not None and command.integer("after") != self.last:
+                self._head = None
+                why = f"it follows command {command.integer('after')}, which did not run"
+                self._refuse(command, "dropped", why, loop.tick)
+                continue
             if command is None or command.integer("tick") > loop.tick + 1:
                 await self._idle_tick(loop, script)
                 continue
             self._head, self._idle = None, False
             seq, ident = command.integer("seq"), command.text("id")
-            if command.integer("after") != self.last:
-                why = f"it follows command {command.integer('after')}, which did not run"
-                self._refuse(command, "dropped", why, loop.tick)
-                continue
             if command.integer("tick") <= loop.tick:
                 why = (
                     f"tick {command.integer('tick')} had passed (the robot is at tick {loop.tick})"

@@ -23,8 +23,11 @@ def _ticks(srv: Server, least: int) -> bool:
 
 
 def _recv(ws: object, *skip: str) -> dict[str, object]:
-    """The next message that is not a heartbeat, telemetry or log records (nor ``skip``)."""
+    """The next message that is not a heartbeat, telemetry or log records (nor ``skip``),
+    within 30 s."""
+    end = time.monotonic() + 30
     while True:
+        assert time.monotonic() < end, "no reply within 30 s"
         msg = json.loads(ws.recv(timeout=10))  # type: ignore[attr-defined]
         if msg["type"] not in ("heartbeat", "telemetry", "records", *skip):
             return dict(msg)
@@ -145,3 +148,43 @@ def test_bad_input_gets_the_documented_errors_and_the_server_keeps_serving(
         assert not any(r["kind"] == "scene" for r in srv.records())  # nothing ran
         code, _summary, err = run_operator(srv, "reactions.dial")
         assert code == 0, err
+
+
+def test_a_block_after_its_tick_is_refused_late_and_the_robot_holds(tmp_path: Path) -> None:
+    """A client of its own opens a block session, sends the first block, then one tagged
+    at a tick the robot has passed: ``late``; one chained after that: ``dropped``."""
+    import dial
+    from dial.parser.script import TBlock
+    from dial.remote.blocks import describe
+    from dial.remote.walk import upload
+
+    script = dial.load("reactions.dial")
+    blocks = [s for s in script.timeline if isinstance(s, TBlock)]
+    with server(tmp_path, pace=0.2) as srv:
+        token = srv.token_file.read_text().strip()
+        with websockets.connect(srv.url) as ws:
+            ws.send(json.dumps({"v": 1, "type": "hello", "token": token, "role": "operator"}))
+            assert _recv(ws)["type"] == "welcome"
+
+            def send(type_: str, seq: int, **fields: object) -> None:
+                ws.send(json.dumps({"v": 1, "type": type_, "seq": seq, "id": f"c{seq}", **fields}))
+
+            send("open", 1, script=upload(script), tick_length=0.1)
+            assert _recv(ws)["type"] == "ack"
+            assert _recv(ws)["checked"] is True
+            first = describe(script, blocks[0])["block"]
+            send("block", 2, tick=1, after=1, script=script.path, block=first)
+            second = describe(script, blocks[1])["block"]
+            send("block", 3, tick=2, after=2, script=script.path, block=second)
+            send("block", 4, tick=40, after=3, script=script.path, block=second)
+            replies = [_recv(ws) for _ in range(6)]
+            by_seq = {(r["type"], r.get("seq")) for r in replies}
+            assert {("ack", 2), ("ack", 3), ("ack", 4), ("result", 2)} <= by_seq
+            refused = {r["seq"]: r for r in replies if r["type"] == "refused"}
+            assert refused[3]["code"] == "late" and "holds" in str(refused[3]["message"])
+            assert refused[4]["code"] == "dropped"
+            send("stop", 5)
+            while _recv(ws)["type"] != "finished":
+                pass
+        blocks_run = [r for r in srv.records() if r["kind"] == "block"]
+    assert len(blocks_run) == 1  # the first only
