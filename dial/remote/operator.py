@@ -13,10 +13,11 @@ from __future__ import annotations
 import json
 import time
 from dataclasses import dataclass
-from typing import TextIO
+from typing import TYPE_CHECKING, TextIO
 
 import trio
 
+from dial.engine.observe import Observer
 from dial.engine.result import Criteria, RunResult
 from dial.errors import DialError
 from dial.parser.script import Script
@@ -31,6 +32,9 @@ from dial.scheduler.log import EventLog, Record
 from dial.scheduler.runner import RunSummary
 from dial.scheduler.signals import StopRequest
 from dial.scheduler.types import RunAborted
+
+if TYPE_CHECKING:
+    from dial.remote.record import ReportedRobot
 
 STOP_WAIT_S = 1.0  # after the watchdog time, how long a stopped robot may take to report
 
@@ -76,6 +80,8 @@ class Operator:
         # (script, event) -> the outcome of its latest run, as reported (what a condition reads)
         self.latest: dict[tuple[str, str], str] = {}
         self.predictor: Predictor | None = None
+        self.reported: ReportedRobot | None = None  # --record, --rerun
+        self.watching: list[Observer] = []  # the prediction's observers (its recording)
         self.channel = Channel(
             options.url,
             options.token,
@@ -142,10 +148,14 @@ class Operator:
                 self.options.progress(tick, float(t), sorted(self.running.values()))
         if self.predictor is not None:
             self.predictor.reported(record)
+        if self.reported is not None:
+            self.reported.record(record)
 
     def _telemetry(self, msg: Message) -> None:
         if self.predictor is not None:
             self.predictor.telemetry(msg)
+        if self.reported is not None:
+            self.reported.sample(msg)
 
     async def result_of(self, seq: int) -> Message:
         """Wait for the robot's result (or refusal) of command ``seq``."""
@@ -234,6 +244,11 @@ def summary_record(op: Operator, wall: float) -> Record:
 async def operate(script: Script, options: OperatorOptions, stop: StopRequest) -> RemoteResult:
     """Run ``script`` at the remote robot; a stop signal stops the robot (it holds)."""
     op = Operator(script, options)
+    if options.record is not None or options.rerun:  # before the link: this takes a while
+        from dial.remote.record import recording
+
+        recorder, op.reported = recording(script, options.record, options.rerun)
+        op.watching.append(recorder)
     start = time.perf_counter()
     message: str | None = None
     async with trio.open_nursery() as nursery:
@@ -250,6 +265,8 @@ async def operate(script: Script, options: OperatorOptions, stop: StopRequest) -
     wall = time.perf_counter() - start
     if op.predictor is not None:
         op.predictor.halt()
+    if op.reported is not None:
+        op.reported.finish()
     if op.channel.lost is not None and op.finished is None:
         message = op.channel.lost
         op.out.link("lost", message=message)
@@ -264,10 +281,18 @@ async def operate(script: Script, options: OperatorOptions, stop: StopRequest) -
 async def _session(script: Script, op: Operator) -> str | None:
     options = op.options
     await op.channel.wait_welcome()
-    if op.options.predict:
-        op.predictor = start_prediction(script, options.tick, op.link, options.diverge_mm)
+    if options.predict:
+        watching: list[Observer] = []
+        if options.record is not None or options.rerun:
+            from dial.remote.record import recording
+
+            recorder, op.reported = recording(script, options.record, options.rerun)
+            watching.append(recorder)
+        op.predictor = start_prediction(script, options.tick, op.link, options.diverge_mm, watching)
     try:
         await run_split(script, op)
+        if op.rejected is not None:  # the script does not check in the robot's world
+            return op.rejected
         await op.wait_finished()
     except _Finished:
         pass

@@ -15,9 +15,9 @@ from __future__ import annotations
 import math
 import threading
 from collections import defaultdict
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 
-from dial.engine.observe import Watched
+from dial.engine.observe import Observer, Watched
 from dial.engine.result import RunResult
 from dial.parser.script import Script
 from dial.remote.protocol import Message
@@ -155,7 +155,11 @@ def _int(value: object) -> int:
 
 
 def start_prediction(
-    script: Script, tick: float, write: Callable[..., None], diverge_mm: float
+    script: Script,
+    tick: float,
+    write: Callable[..., None],
+    diverge_mm: float,
+    observers: Sequence[Observer] = (),
 ) -> Predictor:
     """Start the predicted run in a thread; the predictor compares as reports arrive."""
     predictor = Predictor(write, diverge_mm)
@@ -165,7 +169,8 @@ def start_prediction(
         from dial.engine.run import run as run_engine
 
         try:
-            options = RunOptions(tick=tick, observers=[predictor], stop=predictor.stop)
+            watching = [predictor, *observers]
+            options = RunOptions(tick=tick, observers=watching, stop=predictor.stop)
             run_engine(script, options)
         except Exception as e:  # the prediction is advice: the remote run goes on without it
             predictor.error = str(e)

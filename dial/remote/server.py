@@ -256,8 +256,9 @@ class Server:
     def _lose(self, s: Session, why: str) -> None:
         s.link_record("lost", message=why, tick=self._tick())
         s.stop.request("link lost")
-        if s.thread is None:
+        if s.thread is None:  # nothing ran: the session ends here
             s.state = "lost"
+            s.report("finished", summary={"ok": False, "interrupted": "link lost"})
         print(f"dial serve: session {s.number}: {why}; every effector holds", file=sys.stderr)
         if self.controller is not None:
             self.controller.closing = True

@@ -52,11 +52,10 @@ async def run_split(script: Script, op: Station) -> None:
     op.link("rtt", seconds=round(rtt, 4))
     if op.options.split == "script":
         seq = await ch.command("run", tick=1, after=0, script=upload(script), tick_length=tick)
-        await op.result_of(seq)
+        _accepted(await op.result_of(seq))
         return
     seq = await ch.command("open", script=upload(script), tick_length=tick)
-    if (await op.result_of(seq)).type == "refused":
-        return
+    _accepted(await op.result_of(seq))
     walker = Walker(op, seq, lead_ticks(op, rtt))
     try:
         await walker.walk(script, script.timeline)
@@ -64,6 +63,13 @@ async def run_split(script: Script, op: Station) -> None:
         await walker.end(str(e))
         return
     await walker.end(None)
+
+
+def _accepted(result: Message) -> None:
+    """The robot took the script (else a one-line error; a rejected script's diagnostics
+    are the operator's message already)."""
+    if result.type == "refused" and result.text("code") != "rejected":
+        raise DialError(f"the robot refused the script: {result.text('message')}")
 
 
 def lead_ticks(op: Station, rtt: float) -> int:
