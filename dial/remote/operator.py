@@ -36,6 +36,7 @@ from dial.scheduler.types import RunAborted
 if TYPE_CHECKING:
     from dial.remote.record import ReportedRobot
 
+PREDICTION_WAIT_S = 10.0  # how long a finished run waits for its prediction to catch up
 STOP_WAIT_S = 1.0  # after the watchdog time, how long a stopped robot may take to report
 
 
@@ -264,7 +265,7 @@ async def operate(script: Script, options: OperatorOptions, stop: StopRequest) -
         nursery.cancel_scope.cancel()
     wall = time.perf_counter() - start
     if op.predictor is not None:
-        op.predictor.halt()
+        op.predictor.finish(PREDICTION_WAIT_S if op.finished is not None else 0.0)
     if op.reported is not None:
         op.reported.finish()
     if op.channel.lost is not None and op.finished is None:

@@ -44,6 +44,8 @@ class Predictor:
         self.off = False  # the tool is away from the prediction now
         self.running: dict[tuple[str, int], str] = {}
         self._starts: dict[int, int] = {}  # the prediction's blocks: number -> first period
+        # Reports not compared yet: (a record or a sample, the robot's running events then).
+        self._pending: list[tuple[Record | None, Message | None, str | None]] = []
         self._scanned = 0  # its log records looked at so far
 
     # -- the predicted run (in its thread) ------------------------------------------------------
@@ -66,29 +68,48 @@ class Predictor:
         return [] if self.log is None else [r for r in self.log.records if r["kind"] == kind]
 
     # -- the reports (in the operator's trio thread) --------------------------------------------
+    # Each report waits in order until the prediction has got as far (it may lag behind a
+    # robot that runs fast, e.g. while it is being recorded): behind is not wrong.
     def reported(self, record: Record) -> None:
         kind = record.get("kind")
+        key = (str(record.get("event")), _int(record.get("line")))
         if kind == "start":
-            self.running[(str(record.get("event")), _int(record.get("line")))] = str(
-                record.get("event")
-            )
+            self.running[key] = str(record.get("event"))
         elif kind in ("end", "monitor"):
+            self._pending.append((record, None, self._events()))
             if kind == "end":
-                self.running.pop((str(record.get("event")), _int(record.get("line"))), None)
-            self._compare(kind, record)
+                self.running.pop(key, None)
+            self._drain()
 
-    def _compare(self, kind: str, record: Record) -> None:
+    def telemetry(self, msg: Message) -> None:
+        self._pending.append((None, msg, self._events()))
+        self._drain()
+
+    def _events(self) -> str | None:
+        events = sorted(set(self.running.values()))
+        return ", ".join(events) if events else None
+
+    def _drain(self) -> None:
+        while self._pending:
+            record, msg, events = self._pending[0]
+            decided = self._compare(record) if record is not None else self._sample_at(msg, events)
+            if not decided:
+                return
+            self._pending.pop(0)
+
+    def _compare(self, record: Record) -> bool:
         """The k-th end (monitor) of an event's line against the prediction's k-th."""
+        kind = str(record.get("kind"))
         key = (kind, str(record.get("event")), _int(record.get("line")))
         k = self.seen[key]
-        self.seen[key] += 1
         same = [
             r
             for r in self._predicted(kind)
             if r.get("event") == key[1] and _int(r.get("line")) == key[2]
         ]
         if k >= len(same) and not self.done.is_set():
-            return  # the prediction has not got there yet: it is behind, not wrong
+            return False
+        self.seen[key] += 1
         predicted = same[k].get("outcome", "fired") if k < len(same) else "nothing"
         reported = record.get("outcome", "fired")
         if predicted != reported:
@@ -101,35 +122,48 @@ class Predictor:
                 reported=reported,
                 predicted=predicted,
             )
+        return True
 
-    def telemetry(self, msg: Message) -> None:
-        """A sample at ``since`` periods into the robot's block ``block``: against the
+    def _sample_at(self, msg: Message | None, events: str | None) -> bool:
+        """A sample at ``since`` periods into the robot's block ``block``, against the
         prediction as far into its block (at most to its next block's start)."""
+        assert msg is not None
+        done = self.done.is_set()
         block, offset = msg.integer("block"), msg.integer("since")
         predicted = self._block_start(block)
         if predicted is None:
-            return
+            return done or block == 0  # not there yet; or never will be, or before block 1
         following = self._block_start(block + 1)
         at = predicted + offset if following is None else min(predicted + offset, following)
         if at >= len(self.tool):
-            return  # not predicted yet
+            if not done:
+                return False
+            at = len(self.tool) - 1
         tool = [float(v) for v in msg.items("tool") if isinstance(v, int | float)]
         if len(tool) != 3:
-            return
+            return True
         distance = math.dist(tool, self.tool[at])
         limit = self.diverge_mm
         if distance > limit and not self.off:
-            events = sorted(set(self.running.values()))
             self.write(
                 "diverged",
                 what="tool",
-                event=", ".join(events) if events else None,
+                event=events,
                 tick=msg.integer("tick"),
                 t=msg.number("t"),
                 distance_mm=round(distance, 2),
                 limit_mm=limit,
             )
         self.off = distance > limit
+        return True
+
+    def finish(self, wait: float) -> None:
+        """At the run's end: give the prediction up to ``wait`` s to get there, compare what
+        is left, and stop it."""
+        if self.thread is not None:
+            self.thread.join(timeout=wait)
+        self._drain()
+        self.halt()
 
     def halt(self) -> None:
         """Stop the predicted run at its next control period and wait for its thread (a
