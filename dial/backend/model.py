@@ -13,6 +13,7 @@ import copy
 import os
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import mujoco
 import numpy as np
@@ -21,6 +22,9 @@ from numpy.typing import ArrayLike, NDArray
 from dial.errors import DialError
 from dial.resources import data_dir
 from dial.robot.view import FingerView, RobotView
+
+if TYPE_CHECKING:
+    from dial.scene.world import World
 
 ROBOT_DIR = data_dir("models") / "utah_hand_puma"
 ROBOT_XML = ROBOT_DIR / "utah_hand_puma.xml"
@@ -199,6 +203,19 @@ class RobotIndex:
             moment_arm=float(np.abs(model.wrap_prm[model.tendon_adr[tendon_ids]]).max()),
             tension_limit=float(model.actuator_forcerange[tendons, 1].max()),
         )
+
+
+def scene_bodies(model: mujoco.MjModel, world: World) -> list[int]:
+    """Bodies a perturbation moves: every free body, and the world file's fixed objects."""
+    named = {
+        int(mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, b)) for b in world.objects.values()
+    }
+    free = {
+        int(model.jnt_bodyid[j])
+        for j in range(model.njnt)
+        if model.jnt_type[j] == mujoco.mjtJoint.mjJNT_FREE
+    }
+    return sorted(named | free)
 
 
 def robot_view(model: mujoco.MjModel, index: RobotIndex) -> RobotView:
