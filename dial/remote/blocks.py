@@ -23,7 +23,7 @@ import trio
 
 from dial.engine.observe import Watched, fan_out
 from dial.engine.result import RunResult, measure_criteria
-from dial.engine.setup import prepare
+from dial.engine.setup import Factory, prepare
 from dial.parser.script import (
     Run,
     Script,
@@ -39,7 +39,6 @@ from dial.parser.script import (
     iter_steps,
     scripts_of,
 )
-from dial.primitives import make_factory
 from dial.remote.protocol import Message
 from dial.remote.session import Session
 from dial.remote.telemetry import RobotConfig, Telemetry, disturbances
@@ -244,7 +243,7 @@ def run_blocks(
     telemetry.begin(Watched(robot, ctx.world, log))
     runner = BlockRunner(
         robot,
-        make_factory(ctx),
+        Factory(ctx),
         first.number("tick_length"),
         log,
         observe=fan_out([telemetry]),
