@@ -137,7 +137,7 @@ def run(
     stop signal (SIGINT, SIGTERM) ends the run cleanly: ``result.summary.interrupted``.
     """
     items, saved = _checked(tick, speed, seed, perturb, disturb, save_at, resume)
-    check_watching(record, video, rerun, viewer)  # before the script: usage comes first
+    _check_watching(record, video, rerun, viewer)  # before the script: usage comes first
     script = _script(script, scene)
     from dial.engine import RunOptions
     from dial.engine import run as run_engine
@@ -216,7 +216,7 @@ def _event_names(script: Script) -> set[str]:
     return {name for called in scripts_of(script) for name in called.events}
 
 
-def check_watching(
+def _check_watching(
     record: str | Path | None, video: str | Path | None, rerun: bool, viewer: bool
 ) -> None:
     """What can be known about ``record``, ``video``, ``rerun`` and ``viewer`` before a run."""

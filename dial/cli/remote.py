@@ -207,19 +207,16 @@ def check_remote(args: argparse.Namespace) -> None:
         "--save-at": args.save_at,
         "--resume": args.resume,
         "--realtime": args.realtime,
+        "--record": args.record,  # not yet: the predicted and the reported robot together
+        "--rerun": args.rerun,
     }
     given = [flag for flag, value in local.items() if value]
     if given:
         raise UsageError(
             f"{', '.join(given)}: not with --remote (the robot's world is perturbed and "
-            "disturbed at 'dial serve'; a remote run is paced by the robot)"
+            "disturbed at 'dial serve'; a remote run is paced by the robot; a recording of "
+            "the predicted and the reported robot together is not done yet)"
         )
-    if (args.record or args.rerun) and args.no_predict:
-        raise UsageError("--record and --rerun draw the prediction: not with --no-predict")
-    if args.record or args.rerun:
-        from dial.api import check_watching
-
-        check_watching(args.record, None, args.rerun, False)
     if args.link is not None:
         from dial.remote.link import parse_link  # a usage error before anything connects
 

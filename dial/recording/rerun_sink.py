@@ -37,9 +37,8 @@ from dial.backend.model import FINGERS
 from dial.errors import DialError
 from dial.recording import layout
 from dial.recording.frames import Batch
-from dial.recording.geometry import body_paths, moving_bodies, shapes, superquadric_mesh
-from dial.recording.lanes import STATE_COLORS, Lane, LanePlan, Lanes, Phase
-from dial.recording.rerun_shapes import SOLID, archetype, quat
+from dial.recording.geometry import Shape, body_paths, moving_bodies, shapes, superquadric_mesh
+from dial.recording.lanes import STATE_COLORS, LanePlan, Lanes, Phase
 from dial.recording.task import Series
 from dial.recording.timeline import describe, when
 from dial.robot.snapshot import FloatArray
@@ -56,6 +55,7 @@ TASK_COLOR = (255, 255, 255)
 GUARD_COLOR, POINT_COLOR, FIT_COLOR = (255, 80, 40), (40, 160, 255), (255, 200, 0, 140)
 GUARD_SHOWN_S = 2.0  # simulated seconds a guard's contact marker stays
 LEVELS = {"info": "INFO", "warn": "WARN", "error": "ERROR"}  # rerun's TextLogLevel
+SOLID = rr.components.FillMode.Solid
 PLANE_THICKNESS = 1e-3  # m, to draw a fitted plane as a thin box
 VIEWER_PORT = 9876  # rerun's default
 FLUSH_TIMEOUT_S = 10.0
@@ -67,6 +67,39 @@ def _listening(port: int) -> bool:
     except OSError:
         return False
     return True
+
+
+def _rgba(rgba: FloatArray) -> np.ndarray:
+    return np.asarray(np.round(np.clip(rgba, 0.0, 1.0) * 255), dtype=np.uint8)
+
+
+def _quat(wxyz: FloatArray) -> rr.Quaternion:
+    """MuJoCo's (w, x, y, z) as rerun's quaternion, stored (x, y, z, w)."""
+    return rr.Quaternion(xyzw=[wxyz[1], wxyz[2], wxyz[3], wxyz[0]])
+
+
+def _archetype(shape: Shape) -> Any:
+    color = _rgba(shape.rgba)
+    r, half = float(shape.size[0]), float(shape.size[1])
+    if shape.kind == "box":
+        return rr.Boxes3D(half_sizes=[shape.size], colors=color, fill_mode=SOLID)
+    if shape.kind in ("sphere", "ellipsoid"):
+        size = [r, r, r] if shape.kind == "sphere" else shape.size
+        return rr.Ellipsoids3D(half_sizes=[size], colors=color, fill_mode=SOLID)
+    if shape.kind == "capsule":  # rerun's capsule starts at the origin; MuJoCo's is centred
+        return rr.Capsules3D(
+            lengths=[2 * half],
+            radii=[r],
+            translations=[[0.0, 0.0, -half]],
+            colors=color,
+            fill_mode=SOLID,
+        )
+    if shape.kind == "cylinder":
+        return rr.Cylinders3D(lengths=[2 * half], radii=[r], colors=color, fill_mode=SOLID)
+    assert shape.vertices is not None and shape.faces is not None
+    return rr.Mesh3D(
+        vertex_positions=shape.vertices, triangle_indices=shape.faces, albedo_factor=color
+    )
 
 
 def _shade(color: tuple[int, int, int], factor: float) -> tuple[int, int, int]:
@@ -137,11 +170,11 @@ class RerunSink:
         self._bodies = [paths[b] for b in sorted(moving)]
         for b in range(1, model.nbody):
             if b not in moving:
-                pose = rr.Transform3D(translation=data.xpos[b], quaternion=quat(data.xquat[b]))
+                pose = rr.Transform3D(translation=data.xpos[b], quaternion=_quat(data.xquat[b]))
                 rec.log(paths[b], pose, static=True)
         for shape in shapes(model):
-            pose = rr.Transform3D(translation=shape.pos, quaternion=quat(shape.quat))
-            rec.log(f"{paths[shape.body]}/{shape.name}", pose, archetype(shape), static=True)
+            pose = rr.Transform3D(translation=shape.pos, quaternion=_quat(shape.quat))
+            rec.log(f"{paths[shape.body]}/{shape.name}", pose, _archetype(shape), static=True)
         self._styles(task)
         self._tactile_key()
 
@@ -302,10 +335,10 @@ class RerunSink:
             self.rec.log(path, config, static=True)
         return path
 
-    def _phases(self, phases: list[Phase], under: Lane = ()) -> None:
+    def _phases(self, phases: list[Phase]) -> None:
         """Lane changes, each at its own time; a lane's first change brings its colours."""
         for phase in phases:
-            path = self._lane((*under, *phase.lane))
+            path = self._lane(phase.lane)
             self._at(phase.t, phase.tick)
             state = (
                 rr.StateChange.cleared()
@@ -357,28 +390,6 @@ class RerunSink:
                     vertex_positions=vertices, triangle_indices=faces, albedo_factor=FIT_COLOR
                 ),
             )
-
-    # -- a second robot: a remote run's reported one, beside the predicted (docs/remote.md) --
-    def ghost(self, model: mujoco.MjModel, paths: Mapping[int, str]) -> None:
-        """The geometry of the bodies in ``paths`` again, under those entity paths."""
-        for shape in shapes(model):
-            if shape.body in paths:
-                pose = rr.Transform3D(translation=shape.pos, quaternion=quat(shape.quat))
-                self.rec.log(
-                    f"{paths[shape.body]}/{shape.name}", pose, archetype(shape), static=True
-                )
-
-    def poses(self, t: float, tick: int, paths: Mapping[int, str], data: mujoco.MjData) -> None:
-        """Those bodies' poses at simulated time ``t`` and ``tick``."""
-        self._at(t, tick)
-        for b, path in paths.items():
-            self.rec.log(
-                path, rr.Transform3D(translation=data.xpos[b], quaternion=quat(data.xquat[b]))
-            )
-
-    def phases(self, phases: list[Phase], under: Lane) -> None:
-        """A second set of lanes' changes, under the entity path ``under``."""
-        self._phases(phases, under)
 
     def close(self) -> None:
         self._phases(self.lanes.flush())

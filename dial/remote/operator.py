@@ -13,11 +13,10 @@ from __future__ import annotations
 import json
 import time
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, TextIO
+from typing import TextIO
 
 import trio
 
-from dial.engine.observe import Observer
 from dial.engine.result import Criteria, RunResult
 from dial.errors import DialError
 from dial.parser.script import Script
@@ -32,9 +31,6 @@ from dial.scheduler.log import EventLog, Record
 from dial.scheduler.runner import RunSummary
 from dial.scheduler.signals import StopRequest
 from dial.scheduler.types import RunAborted
-
-if TYPE_CHECKING:
-    from dial.remote.record import ReportedRobot
 
 PREDICTION_WAIT_S = 10.0  # how long a finished run waits for its prediction to catch up
 STOP_WAIT_S = 1.0  # after the watchdog time, how long a stopped robot may take to report
@@ -81,8 +77,7 @@ class Operator:
         # (script, event) -> the outcome of its latest run, as reported (what a condition reads)
         self.latest: dict[tuple[str, str], str] = {}
         self.predictor: Predictor | None = None
-        self.reported: ReportedRobot | None = None  # --record, --rerun
-        self.watching: list[Observer] = []  # the prediction's observers (its recording)
+
         self.channel = Channel(
             options.url,
             options.token,
@@ -149,14 +144,10 @@ class Operator:
                 self.options.progress(tick, float(t), sorted(self.running.values()))
         if self.predictor is not None:
             self.predictor.reported(record)
-        if self.reported is not None:
-            self.reported.record(record)
 
     def _telemetry(self, msg: Message) -> None:
         if self.predictor is not None:
             self.predictor.telemetry(msg)
-        if self.reported is not None:
-            self.reported.sample(msg)
 
     async def result_of(self, seq: int) -> Message:
         """Wait for the robot's result (or refusal) of command ``seq``."""
@@ -245,11 +236,6 @@ def summary_record(op: Operator, wall: float) -> Record:
 async def operate(script: Script, options: OperatorOptions, stop: StopRequest) -> RemoteResult:
     """Run ``script`` at the remote robot; a stop signal stops the robot (it holds)."""
     op = Operator(script, options)
-    if options.record is not None or options.rerun:  # before the link: this takes a while
-        from dial.remote.record import recording
-
-        recorder, op.reported = recording(script, options.record, options.rerun)
-        op.watching.append(recorder)
     start = time.perf_counter()
     message: str | None = None
     async with trio.open_nursery() as nursery:
@@ -266,8 +252,6 @@ async def operate(script: Script, options: OperatorOptions, stop: StopRequest) -
     wall = time.perf_counter() - start
     if op.predictor is not None:
         op.predictor.finish(PREDICTION_WAIT_S if op.finished is not None else 0.0)
-    if op.reported is not None:
-        op.reported.finish()
     if op.channel.lost is not None and op.finished is None:
         message = op.channel.lost
         op.out.link("lost", message=message)
@@ -283,13 +267,7 @@ async def _session(script: Script, op: Operator) -> str | None:
     options = op.options
     await op.channel.wait_welcome()
     if options.predict:
-        watching: list[Observer] = []
-        if options.record is not None or options.rerun:
-            from dial.remote.record import recording
-
-            recorder, op.reported = recording(script, options.record, options.rerun)
-            watching.append(recorder)
-        op.predictor = start_prediction(script, options.tick, op.link, options.diverge_mm, watching)
+        op.predictor = start_prediction(script, options.tick, op.link, options.diverge_mm)
     try:
         await run_split(script, op)
         if op.rejected is not None:  # the script does not check in the robot's world

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import TextIO
 
 from dial.remote.link import LinkSpec
@@ -26,6 +25,4 @@ class OperatorOptions:
     log: TextIO | None = None
     progress: Progress | None = None
     predict: bool = True
-    record: Path | None = None  # --record: the predicted and the reported robot together
-    rerun: bool = False  # --rerun: the same, streamed to a spawned viewer
     observers: list[object] = field(default_factory=list)

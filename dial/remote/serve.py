@@ -105,7 +105,5 @@ def run_remote(
         log=log,
         progress=progress,
         predict=not args.no_predict,
-        record=None if args.record is None else Path(args.record),
-        rerun=args.rerun,
     )
     return trio.run(operate, script, options, stop)
