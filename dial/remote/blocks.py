@@ -44,7 +44,7 @@ from dial.remote.session import Session
 from dial.remote.telemetry import RobotConfig, Telemetry, disturbances
 from dial.robot.snapshot import Snapshot
 from dial.scheduler.log import EventLog, clean
-from dial.scheduler.position import Frame, Path
+from dial.scheduler.position import Frame, TimelinePath
 from dial.scheduler.runner import Runner
 from dial.scheduler.ticks import TickLoop
 from dial.scheduler.types import Interrupted, RunAborted
@@ -118,7 +118,7 @@ class BlockRunner(Runner[Snapshot]):
     _head: Message | None = None
     _idle = False
 
-    async def _main(self, loop: TickLoop[Snapshot], script: Script, path: Path) -> None:
+    async def _main(self, loop: TickLoop[Snapshot], script: Script, path: TimelinePath) -> None:
         steps = {
             (s.path, step.line): (s, step)
             for s in scripts_of(script)

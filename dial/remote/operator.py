@@ -28,7 +28,7 @@ from dial.remote.protocol import Message
 from dial.remote.walk import run_split
 from dial.scene.of_script import script_world
 from dial.scheduler.log import EventLog, Record
-from dial.scheduler.runner import RunSummary
+from dial.scheduler.runner import Tally
 from dial.scheduler.signals import StopRequest
 from dial.scheduler.types import RunAborted
 
@@ -180,7 +180,7 @@ def remote_result(script: Script, op: Operator, wall: float) -> RunResult | None
         return None
     error = s.get("error")
     outcomes = s.get("outcomes")
-    summary = RunSummary(
+    summary = Tally(
         ok=error is None and s.get("interrupted") is None,
         error=None if error is None else RunAborted(str(error)),
         sim_time=float(str(s.get("sim_time", 0.0))),
