@@ -15,7 +15,7 @@ from __future__ import annotations
 import math
 import os
 import sys
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Iterator, Sequence
 from contextlib import contextmanager, suppress
 from pathlib import Path
 from typing import TYPE_CHECKING, TextIO
@@ -32,9 +32,8 @@ from dial.scene.resolve import scene_option
 if TYPE_CHECKING:  # trio and MuJoCo load only to run: `import dial` and checking stay light
     from dial.debug import Break, Console
     from dial.engine import Observer, RunResult
-    from dial.engine.state import Saved
-
-Progress = Callable[[int, float, list[str]], None]
+    from dial.engine.state import StateFile
+    from dial.scheduler.periods import Progress
 
 
 def load(path: str | Path, *, scene: str | None = None) -> Script:
@@ -91,7 +90,7 @@ def writable(path: str | Path, what: str) -> Path:
 
 
 @contextmanager
-def _log_sink(log: str | Path | TextIO | None) -> Iterator[TextIO | None]:
+def log_sink(log: str | Path | TextIO | None) -> Iterator[TextIO | None]:
     if log is None or not isinstance(log, str | Path):
         yield log
         return
@@ -143,7 +142,7 @@ def run(
     from dial.engine import run as run_engine
 
     stops, console = _pausing(script, breaks, step, console)
-    with _log_sink(log) as sink:
+    with log_sink(log) as sink:
         options = RunOptions(
             tick=tick,
             speed=speed,
@@ -172,7 +171,7 @@ def _checked(
     disturb: Sequence[str | Disturbance],
     save_at: tuple[int, str | Path] | None,
     resume: str | Path | None,
-) -> tuple[list[Disturbance], Saved | None]:
+) -> tuple[list[Disturbance], StateFile | None]:
     """The option checks that need no script: ranges, SPECs, the state files."""
     check_options(tick, speed, seed, perturb)
     if resume is not None and (tick is not None or speed != 1.0 or seed or perturb or disturb):
@@ -264,7 +263,7 @@ def _watchers(
     return watchers
 
 
-def _load_state(path: Path) -> Saved:
+def _load_state(path: Path) -> StateFile:
     from dial.engine.state import load as load_state  # MuJoCo loads only to run
 
     return load_state(path)

@@ -2,9 +2,9 @@
 
 A **guard** belongs to a guarded move: when it trips, the driver freezes the guarded
 effector at that physics step. A **monitor** belongs to a watched span (DESIGN 2.7): it
-freezes nothing; the runner preempts the block. Both read the same contact readings as a
-contact wait does (:func:`~dial.robot.contact.contact_reading`), so a guard, a monitor
-and a wait mean the same contact.
+freezes nothing; the runner preempts the block. Both read the contact readings of
+:mod:`dial.robot.contact`, as a contact wait does, so a guard, a monitor and a wait mean
+the same contact.
 """
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ import numpy as np
 
 from dial.backend.index import RobotIndex
 from dial.backend.model import hand_angles, tendon_tensions
-from dial.robot.contact import POSITION_LEVER
+from dial.robot.contact import force_reading, position_reading, tactile_reading
 from dial.robot.snapshot import FloatArray, Trip
 
 
@@ -29,7 +29,7 @@ class Guard:
     effector: str | None
     conditions: tuple[tuple[str, float], ...]
     sense: tuple[int, ...]
-    baseline: FloatArray  # (16,) differentials when armed, for force conditions
+    baseline: FloatArray  # (16,) differentials when added, for force conditions
     negated: bool = False
     floats: tuple[float, ...] = field(init=False, repr=False)  # baseline, read every step
 
@@ -39,13 +39,13 @@ class Guard:
 
 class Readings:
     """What guards and monitors read at one physics step, computed only as far as they need
-    (this runs after every physics step while one is armed). The formulas are
-    :func:`~dial.robot.contact.contact_reading`'s; a dropped-out sensor reads 0. One per
-    robot: :meth:`at_step` starts each step afresh."""
+    (this runs after every physics step while one is tested), each once per step: the
+    readings of :mod:`dial.robot.contact`; a dropped-out sensor reads 0. One per robot:
+    :meth:`at_step` starts each step afresh."""
 
     __slots__ = (
-        "_data", "_diff", "_dropped", "_index", "_joints", "_lever", "_q", "_tactile",
-        "_target", "_tensions", "_tips",
+        "_bits", "_data", "_dropped", "_full", "_index", "_lever", "_loads", "_q", "_tactile",
+        "_target", "_tendons", "_tensions", "_tips",
     )  # fmt: skip
 
     def __init__(self, data: mujoco.MjData, index: RobotIndex, tactile_adr: Sequence[int]) -> None:
@@ -60,53 +60,57 @@ class Readings:
         # extensor per joint).
         in_order = first >= 0 and np.array_equal(adr, np.arange(first, first + len(adr)))
         self._tensions = data.sensordata[first : first + len(adr)] if in_order else None
-        # Each finger's joints: (mask bit, index of the joint among the hand's joints).
-        bits = index.hand_bits.tolist()
-        self._joints: list[list[tuple[int, int]]] = [
-            [(b, i) for i, b in enumerate(bits) if b // 4 == f]
-            for f in range(len(index.profile.fingers))
-        ]
+        self._bits: list[int] = index.hand_bits.tolist()  # each joint's mask bit
+        self._full, self._tendons = index.full_hand, index.tendons
         self._lever = index.lever  # a joint torque (N m) over this is its load in N
         self._target: FloatArray = np.zeros(16)
         self._dropped: frozenset[tuple[str, int]] = frozenset()
-        self._diff: list[float] | None = None  # this step's load readings, as Python floats
+        self._loads: list[float] | None = None  # this step's 16 joint loads, Python floats
         self._q: FloatArray | None = None
 
     def at_step(self, target: FloatArray, dropped: frozenset[tuple[str, int]]) -> Readings:
         self._target, self._dropped = target, dropped
-        self._diff = self._q = self._tips = None
+        self._loads = self._q = self._tips = None
         return self
 
     def value(self, kind: str, f: int, baseline: Sequence[float]) -> float:
         """The reading of contact ``kind`` on finger ``f``: m (tactile, position) or N."""
         if self._dropped and (kind, f) in self._dropped:
             return 0.0
-        if kind == "tactile":
-            # The deepest taxel, once per finger and step; argmax costs a quarter of max.
+        if kind == "tactile":  # once per finger and step
             tips = self._tips
             if tips is None:
                 tips = self._tips = [None] * len(self._tactile)
             tip = tips[f]
             if tip is None:
                 row = self._tactile[f]
-                tip = tips[f] = 0.0 if row is None else float(row.item(row.argmax()))
+                tip = tips[f] = 0.0 if row is None else tactile_reading(row)
             return tip
-        if kind == "force":
-            # The largest change of a finger's joint loads since the guard was armed, in
-            # Python floats: the loads are read once per step, whatever the guards.
-            if self._diff is None:
+        if kind == "force":  # the loads are read once per step, whatever the guards
+            if self._loads is None:
                 view = self._tensions
                 raw = view if view is not None else tendon_tensions(self._data, self._index)
-                self._diff = raw.tolist()
-            t: list[float] = self._diff
-            if self._index.tendons:
-                return max(abs(t[2 * i] - t[2 * i + 1] - baseline[k]) for k, i in self._joints[f])
-            lever = self._lever
-            return max(abs(t[i] / lever - baseline[k]) for k, i in self._joints[f])
+                self._loads = self._joint_loads(raw.tolist())
+            return force_reading(self._loads, baseline, f)
         if self._q is None:
             self._q = hand_angles(self._data, self._index)
-        joints = slice(4 * f, 4 * f + 4)
-        return float(np.linalg.norm(self._target[joints] - self._q[joints])) * POSITION_LEVER
+        return position_reading(self._target, self._q, f)
+
+    def _joint_loads(self, raw: list[float]) -> list[float]:
+        """The 16 joint loads (N, mask order, 0 where the hand has no joint) from the raw
+        load readings, in Python floats: :func:`dial.backend.model.joint_loads`."""
+        if self._tendons:
+            if self._full:
+                return [raw[2 * k] - raw[2 * k + 1] for k in range(16)]
+            loads = [0.0] * 16
+            for i, bit in enumerate(self._bits):
+                loads[bit] = raw[2 * i] - raw[2 * i + 1]
+            return loads
+        lever = self._lever
+        loads = [0.0] * 16
+        for i, bit in enumerate(self._bits):
+            loads[bit] = raw[i] / lever
+        return loads
 
 
 def first_trip(guard: Guard, r: Readings, time: float, step: int) -> Trip | None:

@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING
 
 from dial import api
 from dial.cli.common import UsageError, load_script, scene_argument
+from dial.cli.remote import add_run_options, check_remote
 from dial.recording.timeline import qualified_event
 from dial.scheduler.signals import EXIT_STATUS, StopRequest, catch_stop_signals
 
@@ -110,28 +111,28 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         help="go on from a state file (with its tick, seed, perturbation and disturbances); "
         "lines of the script before the saved block must be unchanged",
     )
+    add_run_options(p)
     p.set_defaults(func=cmd_run)
 
 
 def cmd_run(args: argparse.Namespace) -> int:
-    # From here to the exit, a stop signal stops the run (which catches it first) or, once
-    # the run is over, is ignored: a second Ctrl-C cannot cut the summary or the log short.
-    stop = StopRequest()
-    with catch_stop_signals(stop):
-        return _run(args, stop)
+    # The command owns the stop signals from here to the exit: one stops the run (dial.run
+    # checks the options, then the script, then runs it) or, once the run is over, is
+    # ignored: a second Ctrl-C cannot cut the summary or the log short.
+    check_remote(args)
+    with catch_stop_signals() as stop:
+        if args.remote is not None:
+            return _remote(args, stop)
+        return _run(args)
 
 
-def _run(args: argparse.Namespace, stop: StopRequest) -> int:
+def _run(args: argparse.Namespace) -> int:
     if args.log_states and not args.log:
         raise UsageError("--log-states writes into the log: give --log FILE.jsonl too")
-    api.check_options(args.tick, args.speed, args.seed, args.perturb)
     save_at = _save_at(args.save_at)
-    script = load_script(args.script, args.scene)
-    if stop.signal is not None:  # while the script was being checked
-        print(f"dial: interrupted by {stop.signal}", file=sys.stderr)
-        return EXIT_STATUS[stop.signal]
     result = api.run(
-        script,
+        args.script,
+        scene=args.scene,
         tick=args.tick,
         speed=args.speed,
         seed=args.seed,
@@ -179,6 +180,18 @@ def _run(args: argparse.Namespace, stop: StopRequest) -> int:
         )
         return 1
     return 0 if result.ok else 1
+
+
+def _remote(args: argparse.Namespace, stop: StopRequest) -> int:
+    """``dial run --remote``: the options and the script checked here, then the robot's run."""
+    from dial.cli.run_remote import run_remote
+
+    api.check_options(args.tick, args.speed, args.seed, args.perturb)
+    script = load_script(args.script, args.scene)
+    if stop.signal is not None:  # while the script was being checked
+        print(f"dial: interrupted by {stop.signal}", file=sys.stderr)
+        return EXIT_STATUS[stop.signal]
+    return run_remote(args, script, stop, _progress(args.quiet), summary_text)
 
 
 def _save_at(value: list[str] | None) -> tuple[int, str] | None:

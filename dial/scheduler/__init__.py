@@ -2,7 +2,7 @@
 
 from dial.scheduler.log import EventLog, LogError
 from dial.scheduler.primitive import DONE, Allotment, Ended, Now, Outcome, Primitive, Sensor
-from dial.scheduler.runner import Runner, RunSummary, periods_per_tick
+from dial.scheduler.runner import Runner, Tally, periods_per_tick
 from dial.scheduler.signals import EXIT_STATUS, StopRequest, catch_stop_signals
 from dial.scheduler.types import Interrupted, PrimitiveFactory, RunAborted, RunInfo
 
@@ -20,10 +20,10 @@ __all__ = [
     "PrimitiveFactory",
     "RunAborted",
     "RunInfo",
-    "RunSummary",
     "Runner",
     "Sensor",
     "StopRequest",
+    "Tally",
     "catch_stop_signals",
     "periods_per_tick",
 ]
