@@ -53,7 +53,7 @@ class Fields:
             raise self.fail(path, f"missing table [{_join(path, name)}]")
         value = data[name]
         if not isinstance(value, Mapping):
-            raise self.fail((*path, name), f"expected a table, got {_kind(value)}")
+            raise self.fail((*path, name), f"expected a table, got {value_kind(value)}")
         return value
 
     def keys(
@@ -66,7 +66,7 @@ class Fields:
     def string(self, value: Any, path: Path) -> str:
         _present(value)
         if not isinstance(value, str) or not value:
-            raise self.fail(path, f"expected a name (a non-empty string), got {_kind(value)}")
+            raise self.fail(path, f"expected a name (a non-empty string), got {value_kind(value)}")
         return value
 
     def choice(self, value: Any, path: Path, choices: tuple[str, ...]) -> str:
@@ -80,7 +80,7 @@ class Fields:
     ) -> float:
         _present(value)
         if isinstance(value, bool) or not isinstance(value, int | float):
-            raise self.fail(path, f"expected a number, got {_kind(value)}")
+            raise self.fail(path, f"expected a number, got {value_kind(value)}")
         if not math.isfinite(value) or (positive and value <= 0) or (nonnegative and value < 0):
             what = (
                 "a positive number"
@@ -95,7 +95,7 @@ class Fields:
     def integer(self, value: Any, path: Path) -> int:
         _present(value)
         if isinstance(value, bool) or not isinstance(value, int) or value <= 0:
-            raise self.fail(path, f"expected a whole number above 0, got {_kind(value)}")
+            raise self.fail(path, f"expected a whole number above 0, got {value_kind(value)}")
         return value
 
     def names(self, value: Any, path: Path, n: int | None = None) -> tuple[str, ...]:
@@ -127,7 +127,7 @@ class Fields:
     def _list(self, value: Any, path: Path, n: int | None, what: str) -> list[Any]:
         _present(value)
         if not isinstance(value, list) or not value:
-            raise self.fail(path, f"expected a list of {what}, got {_kind(value)}")
+            raise self.fail(path, f"expected a list of {what}, got {value_kind(value)}")
         if n is not None and len(value) != n:
             raise self.fail(path, f"expected {n} {what}, got {len(value)}")
         return value
@@ -158,7 +158,8 @@ def _join(path: Path, name: str) -> str:
     return ".".join(str(p) for p in (*path, name))
 
 
-def _kind(value: Any) -> str:
+def value_kind(value: Any) -> str:
+    """What a TOML value is, for a message: "a string ('x')", "a list of 3", "a table"."""
     if isinstance(value, bool):
         return f"a boolean ({str(value).lower()})"
     if isinstance(value, str):
