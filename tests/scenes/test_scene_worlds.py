@@ -51,7 +51,9 @@ PAPER_POSES = {"open_hand", "prelight", "unscrew", "ungrasp", "point", "prepit"}
 
 def test_models_dir_is_the_checkout_models_folder() -> None:
     assert (models_dir() / "utah_hand_puma" / "objects_pour.xml").is_file()
-    assert bundled_scene_names() == SCENES
+    names = bundled_scene_names()
+    assert names[: len(SCENES)] == SCENES  # the first robot's, by name; then the others'
+    assert all(n.startswith("allegro_panda/") for n in names[len(SCENES) :])
 
 
 @pytest.mark.parametrize("name", SCENES)
