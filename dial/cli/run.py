@@ -5,16 +5,25 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from typing import TYPE_CHECKING
 
 from dial import api
-from dial.cli.common import UsageError, load_script, scene_argument
+from dial.cli.common import (
+    UsageError,
+    dataset_arguments,
+    dataset_request,
+    load_script,
+    scene_argument,
+)
 from dial.recording.timeline import qualified_event
 from dial.scheduler.signals import EXIT_STATUS, StopRequest, catch_stop_signals
 
 if TYPE_CHECKING:
+    from dial.dataset.writer import DatasetWriter
     from dial.engine import RunResult
+    from dial.parser.script import Script
 
 DESCRIPTION = (
     "Run a script on the simulated hand and arm. Shows live progress, then each event's "
@@ -110,6 +119,7 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         help="go on from a state file (with its tick, seed, perturbation and disturbances); "
         "lines of the script before the saved block must be unchanged",
     )
+    dataset_arguments(p, sweep=False)
     p.set_defaults(func=cmd_run)
 
 
@@ -126,11 +136,30 @@ def _run(args: argparse.Namespace, stop: StopRequest) -> int:
         raise UsageError("--log-states writes into the log: give --log FILE.jsonl too")
     api.check_options(args.tick, args.speed, args.seed, args.perturb)
     save_at = _save_at(args.save_at)
+    folder, fps, cameras = dataset_request(args)
+    if folder is not None:
+        from dial.dataset.plan import Request, check_request
+
+        check_request(Request(50 if fps is None else fps, tuple(cameras)))
     script = load_script(args.script, args.scene)
     if stop.signal is not None:  # while the script was being checked
         print(f"dial: interrupted by {stop.signal}", file=sys.stderr)
         return EXIT_STATUS[stop.signal]
-    result = api.run(
+    with _dataset(folder, fps) as writer:
+        result = _run_api(args, script, save_at, writer, cameras)
+    if writer is not None and folder is not None:
+        _said_written(writer, folder)
+    return _report(args, result, save_at)
+
+
+def _run_api(
+    args: argparse.Namespace,
+    script: Script,
+    save_at: tuple[int, str] | None,
+    writer: DatasetWriter | None,
+    cameras: list[str],
+) -> RunResult:
+    return api.run(
         script,
         tick=args.tick,
         speed=args.speed,
@@ -149,7 +178,35 @@ def _run(args: argparse.Namespace, stop: StopRequest) -> int:
         step=args.step,
         save_at=save_at,
         resume=args.resume,
+        dataset=writer,
+        cameras=cameras,
     )
+
+
+@contextmanager
+def _dataset(folder: str | None, fps: int | None) -> Iterator[DatasetWriter | None]:
+    """``--dataset DIR``'s writer, open for the run (closing it commits the episode)."""
+    if folder is None:
+        yield None
+        return
+    from dial.dataset.writer import DatasetWriter
+
+    with DatasetWriter(folder, fps=50 if fps is None else fps) as writer:
+        yield writer
+
+
+def _said_written(writer: DatasetWriter, folder: str) -> None:
+    if writer.added:
+        print(
+            f"dial: episode {writer.episodes - 1} ({writer.last_frames} frames) written to "
+            f"{folder}; it holds {writer.episodes} episodes",
+            file=sys.stderr,
+        )
+    else:
+        print(f"dial: no episode written to {folder} (the run did not finish)", file=sys.stderr)
+
+
+def _report(args: argparse.Namespace, result: RunResult, save_at: tuple[int, str] | None) -> int:
     for number, target in result.saved:
         print(f"dial: saved the state before block {number} to {target}", file=sys.stderr)
     if not args.quiet and sys.stderr.isatty():

@@ -1,0 +1,51 @@
+"""What a run or a sweep asks of a dataset (fps, cameras, successful runs only), and the
+features its episodes will have, known before anything runs."""
+
+from __future__ import annotations
+
+import importlib.util
+import os
+import sys
+from dataclasses import dataclass
+
+from dial.dataset.features import DEFAULT_FPS, MAX_FPS, FeatureJSON
+from dial.errors import OptionError
+from dial.scene.world import World
+
+CAMERA_SIZE = (240, 320)  # height, width of every camera's frames
+
+
+@dataclass(frozen=True)
+class Request:
+    """``--fps``, ``--cameras`` and ``--successful-only``: small, so a trial carries it."""
+
+    fps: int = DEFAULT_FPS
+    cameras: tuple[str, ...] = ()
+    successful_only: bool = False
+
+
+def check_request(request: Request) -> None:
+    """A usage error (:class:`OptionError`) for a bad ``--fps`` or a missing extra."""
+    fps = request.fps
+    if isinstance(fps, bool) or not isinstance(fps, int) or not 1 <= fps <= MAX_FPS:
+        raise OptionError(f"--fps must be a whole number from 1 to {MAX_FPS}, got {fps}")
+    if importlib.util.find_spec("pyarrow") is None:
+        raise OptionError("--dataset needs pyarrow: pip install 'dial[dataset]'")
+    if request.cameras and not all(
+        importlib.util.find_spec(m) is not None for m in ("imageio", "imageio_ffmpeg")
+    ):
+        raise OptionError("--cameras needs the optional 'video' extra: pip install 'dial[video]'")
+    if request.cameras and sys.platform.startswith("linux"):  # offscreen, before MuJoCo loads
+        os.environ.setdefault("MUJOCO_GL", "egl")
+
+
+def expected_features(world: World, request: Request) -> dict[str, FeatureJSON]:
+    """The data features of a run in ``world`` (MuJoCo loads: the robot's names live with
+    its model)."""
+    from dial.dataset.features import features
+    from dial.dataset.robot import robot_names, scene_bodies
+
+    bodies = scene_bodies(list(world.objects.values()))
+    cameras = dict.fromkeys(request.cameras, CAMERA_SIZE)
+    spec = features(robot_names(), bodies, cameras, request.fps)
+    return {name: feature.as_json() for name, feature in spec.items()}
