@@ -149,7 +149,8 @@ def run(
     from dial.engine import run as run_engine
 
     stops, console = _pausing(script, breaks, step, console)
-    with _log_sink(log) as sink, _recording(dataset, request, script) as recorder:
+    moved = saved.settings.perturb_mm if saved is not None else perturb
+    with _log_sink(log) as sink, _recording(dataset, request, script, moved) as recorder:
         options = RunOptions(
             tick=tick,
             speed=speed,
@@ -218,7 +219,10 @@ def _dataset_request(
 
 @contextmanager
 def _recording(
-    dataset: str | Path | DatasetWriter | None, request: Request | None, script: Script
+    dataset: str | Path | DatasetWriter | None,
+    request: Request | None,
+    script: Script,
+    perturb_mm: float,
 ) -> Iterator[list[Observer]]:
     """The dataset's recorder as a list of observers (empty without ``dataset=``)."""
     if dataset is None or request is None:
@@ -226,7 +230,7 @@ def _recording(
         return
     from dial.dataset.session import recording
 
-    with recording(dataset, request, script) as recorder:
+    with recording(dataset, request, script, perturb_mm) as recorder:
         yield [recorder]
 
 

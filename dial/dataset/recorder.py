@@ -63,8 +63,18 @@ class Recorder:
 
     what = "the dataset recorder"  # how messages name it
 
-    def __init__(self, script: str, fps: int = DEFAULT_FPS, cameras: Sequence[str] = ()) -> None:
+    def __init__(
+        self,
+        script: str,
+        fps: int = DEFAULT_FPS,
+        cameras: Sequence[str] = (),
+        perturb_mm: float | None = None,
+    ) -> None:
+        """``script`` names the run in its task and metadata; ``perturb_mm`` is the run's
+        ``--perturb`` (None: the length of the shift the log's ``scene`` record gives,
+        which the log rounds to a micrometre)."""
         self.script, self.fps, self.camera_names = script, fps, tuple(cameras)
+        self.perturb_mm = perturb_mm
         self.episode: Episode | None = None
         self.cameras: Cameras | None = None
 
@@ -92,6 +102,11 @@ class Recorder:
         self.pending: int | None = None  # the frame whose action the next period gives
         self.frames = 0
         self._sample()
+
+    def _perturb_mm(self) -> float:
+        if self.perturb_mm is not None:
+            return float(self.perturb_mm)
+        return round(float(np.linalg.norm(self.shift)), 3)
 
     def _due(self, frame: int) -> int:
         """The control period after which frame ``frame`` is taken (rounded half up)."""
@@ -138,8 +153,8 @@ class Recorder:
             scene=self.scene,
             tick=s.tick_length,
             seed=self.seed,
-            perturb_mm=round(float(np.linalg.norm(self.shift)), 6),
-            shift_mm=(round(self.shift[0], 6), round(self.shift[1], 6), round(self.shift[2], 6)),
+            perturb_mm=self._perturb_mm(),
+            shift_mm=(round(self.shift[0], 3), round(self.shift[1], 3), round(self.shift[2], 3)),
             disturbances=tuple(result.disturbances),
             outcomes=dict(s.outcomes),
             success=result.ok,

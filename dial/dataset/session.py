@@ -15,7 +15,7 @@ from dial.scene.of_script import script_world
 
 @contextmanager
 def recording(
-    dataset: str | Path | DatasetWriter, request: Request, script: Script
+    dataset: str | Path | DatasetWriter, request: Request, script: Script, perturb_mm: float
 ) -> Iterator[Recorder]:
     """Check the run's features against the dataset, yield the observer that records it,
     and write its episode once the run has returned (an interrupted run has none). A
@@ -25,7 +25,7 @@ def recording(
     )
     try:
         writer.check(expected_features(script_world(script), request))
-        recorder = Recorder(Path(script.path).name, writer.fps, request.cameras)
+        recorder = Recorder(Path(script.path).name, writer.fps, request.cameras, perturb_mm)
         yield recorder
         if recorder.episode is not None:
             writer.add(recorder.episode)

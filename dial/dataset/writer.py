@@ -15,8 +15,8 @@ back to its last commit, so no half-written episode is ever left behind.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-from contextlib import suppress
+from collections.abc import Iterator, Mapping
+from contextlib import contextmanager, suppress
 from dataclasses import dataclass
 from pathlib import Path
 from types import TracebackType
@@ -155,14 +155,8 @@ class DatasetWriter:
         if problem is not None:
             raise DatasetError(f"cannot write to the dataset '{self.root}': {problem}")
         self.check(episode.features)
-        try:
+        with self._or_rollback():
             return self._write(episode)
-        except BaseException as e:
-            lost = self.episodes - self._state.episodes
-            self.rollback()
-            if isinstance(e, OSError | tables.pa.ArrowException):
-                raise DatasetError(self._failure(e, lost)) from None
-            raise
 
     def close(self) -> None:
         """Commit what was added, and let the folder go; idempotent. A new dataset that got
@@ -272,7 +266,7 @@ class DatasetWriter:
         if out is None:
             self._unmake_if_empty()
             return
-        try:
+        with self._or_rollback():
             out.close()
             written = list(out.written)
             written.append(
@@ -288,16 +282,23 @@ class DatasetWriter:
             written.append((files.write_json(self.root / files.INFO, info), self.root / files.INFO))
             for tmp, final in written:
                 tmp.replace(final)
+        self._open = None
+        data, meta = self._slots
+        self._slots = (files.following(data, CHUNKS_SIZE), files.following(meta, CHUNKS_SIZE))
+        self._state = _Committed(self.episodes, self.frames, tuple(self.tasks), self.stats)
+
+    @contextmanager
+    def _or_rollback(self) -> Iterator[None]:
+        """Whatever fails inside rolls the folder back to its last commit; a write error
+        becomes a one-line DatasetError that says what was lost."""
+        try:
+            yield
         except BaseException as e:
             lost = self.episodes - self._state.episodes
             self.rollback()
             if isinstance(e, OSError | tables.pa.ArrowException):
                 raise DatasetError(self._failure(e, lost)) from None
             raise
-        self._open = None
-        data, meta = self._slots
-        self._slots = (files.following(data, CHUNKS_SIZE), files.following(meta, CHUNKS_SIZE))
-        self._state = _Committed(self.episodes, self.frames, tuple(self.tasks), self.stats)
 
     def rollback(self) -> None:
         """Forget what was written since the last commit, on disk and here."""

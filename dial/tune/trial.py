@@ -68,7 +68,8 @@ def engine_backend(trial: Trial) -> RunReport:
         from dial.dataset.recorder import Recorder
 
         request = trial.dataset
-        recorder = Recorder(Path(trial.display).name, request.fps, request.cameras)
+        name = Path(trial.display).name
+        recorder = Recorder(name, request.fps, request.cameras, trial.perturb_mm)
         options.observers.append(recorder)
     result = run(script, options)
     summary = result.summary
