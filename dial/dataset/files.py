@@ -62,12 +62,14 @@ def stale(root: Path) -> Iterator[Path]:
     yield from root.glob(".*.tmp")
 
 
-def write_json(path: Path, data: object) -> Path:
-    """Write ``data`` as JSON under the temporary name of ``path``; return that name."""
+def write_json(path: Path, data: object, indent: int | None = 4) -> Path:
+    """Write ``data`` as JSON under the temporary name of ``path``; return that name.
+    (``indent=None`` writes one line, with the C encoder: stats of a tactile array are
+    tens of thousands of numbers.)"""
     tmp = temporary(path)
     tmp.parent.mkdir(parents=True, exist_ok=True)
     with open(tmp, "w", encoding="utf-8") as f:
-        f.write(json.dumps(data, indent=4) + "\n")
+        f.write(json.dumps(data, indent=indent) + "\n")
     return tmp
 
 

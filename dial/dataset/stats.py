@@ -1,8 +1,10 @@
 """Feature statistics as LeRobot keeps them: per episode, and over the whole dataset.
 
-Each feature gets ``min``, ``max``, ``mean``, ``std``, ``count`` and the quantiles ``q01``,
-``q10``, ``q50``, ``q90``, ``q99``, element by element over the frames (a vector's stats
-have its shape; a scalar column's have shape (1,)). An episode's quantiles are exact; the
+Each feature gets ``min``, ``max``, ``mean``, ``std``, ``count`` (frames) and the quantiles
+``q01``, ``q10``, ``q50``, ``q90``, ``q99``. As LeRobot computes them, every axis but the last
+is a batch axis: a vector's stats have its shape, a scalar column's shape (1,), and an array
+of more axes has one value per index of its last axis (``observation.tactile``: one per
+column of the pads, over every frame, finger and row). An episode's quantiles are exact; the
 dataset's are LeRobot's aggregate: the frame-weighted mean of the episodes' quantiles. The
 aggregate is updated one episode at a time, so memory does not grow with episodes.
 """
@@ -25,15 +27,15 @@ FeatureStats = dict[str, Stats]  # feature name -> its stats
 def column_stats(values: NDArray[np.generic]) -> Stats:
     """The stats of one feature's column ``(frames, *shape)`` (a (frames,) column counts as
     shape (1,)), computed in float64."""
+    frames = len(values)
     x = np.asarray(values, dtype=np.float64)
-    if x.ndim == 1:
-        x = x[:, None]
+    x = x[:, None] if x.ndim == 1 else x.reshape(-1, x.shape[-1])
     stats: Stats = {
         "min": x.min(axis=0),
         "max": x.max(axis=0),
         "mean": x.mean(axis=0),
         "std": x.std(axis=0),
-        "count": np.array([len(x)], dtype=np.int64),
+        "count": np.array([frames], dtype=np.int64),
     }
     quantiles = np.quantile(x, QUANTILES, axis=0)
     for key, q in zip(QUANTILE_KEYS, quantiles, strict=True):

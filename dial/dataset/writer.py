@@ -15,6 +15,7 @@ back to its last commit, so no half-written episode is ever left behind.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Iterator, Mapping
 from contextlib import contextmanager, suppress
 from dataclasses import dataclass
@@ -268,18 +269,12 @@ class DatasetWriter:
             return
         with self._or_rollback():
             out.close()
-            written = list(out.written)
-            written.append(
-                (
-                    files.write_json(self.root / files.STATS, as_json(self.stats or {})),
-                    self.root / files.STATS,
-                )
-            )
-            tasks = files.temporary(self.root / files.TASKS)
-            tables.pa.parquet.write_table(tables.tasks_table(self.tasks), str(tasks))
-            written.append((tasks, self.root / files.TASKS))
-            info = info_json(self)
-            written.append((files.write_json(self.root / files.INFO, info), self.root / files.INFO))
+            info, stats, tasks = (self.root / p for p in files.META)
+            written = [*out.written, (files.temporary(tasks), tasks)]
+            tables.pa.parquet.write_table(tables.tasks_table(self.tasks), str(written[-1][0]))
+            stats_json = as_json(self.stats or {})
+            written.append((files.write_json(stats, stats_json, indent=None), stats))
+            written.append((files.write_json(info, info_json(self)), info))  # the last
             for tmp, final in written:
                 tmp.replace(final)
         self._open = None
@@ -319,7 +314,9 @@ class DatasetWriter:
         self._unmake_if_empty()
 
     def _failure(self, e: BaseException, lost: int) -> str:
-        why = getattr(e, "strerror", None) or str(e).strip().splitlines()[0]
+        text = getattr(e, "strerror", None) or str(e).strip() or type(e).__name__
+        errno = re.search(r"\[errno \d+\] ([^\n]+)", text)  # pyarrow: "... Detail: [errno 28] ..."
+        why = errno.group(1) if errno else text.splitlines()[0]
         kept = (
             f"it holds {self.episodes} episodes as before"
             if self.episodes

@@ -47,7 +47,11 @@ def test_the_aggregate_stats_are_those_of_all_frames(tmp_path: Path) -> None:
     np.testing.assert_allclose(got["std"], state.std(axis=0), rtol=1e-9)
     np.testing.assert_array_equal(got["min"], state.min(axis=0))
     np.testing.assert_array_equal(got["max"], state.max(axis=0))
-    assert np.shape(stats["observation.tactile"]["q50"]) == (2, 2, 3)
+    tactile = np.concatenate([e.columns["observation.tactile"] for e in episodes]).astype(float)
+    assert stats["observation.tactile"]["count"] == [len(tactile)]  # frames, as LeRobot counts
+    np.testing.assert_allclose(  # one per index of the last axis, as LeRobot keeps them
+        stats["observation.tactile"]["mean"], tactile.reshape(-1, 3).mean(axis=0), rtol=1e-6
+    )
     assert stats["timestamp"]["max"] == [pytest.approx((12 + 10 - 1) / 50, abs=1e-6)]
 
 
