@@ -35,6 +35,7 @@ from dial.dataset.tables import DatasetError
 
 DEFAULT_FILE_MB = 100.0  # LeRobot's default data file size
 CHUNKS_SIZE = 1000  # files per chunk folder, as LeRobot's
+ROWS_PER_GROUP = 50  # episode rows per row group of meta/episodes/
 
 
 def check_fps(fps: int) -> None:
@@ -67,9 +68,25 @@ class _Open:
         self.sink = pa.OSFile(str(files.temporary(self.data_path)), "wb")
         self.data: Any = None  # ParquetWriters, made with the first episode's schemas
         self.meta: Any = None
+        self.rows: list[Any] = []  # episode rows not yet written (one-row Arrow tables)
         self.frames = 0
 
+    def add_row(self, row: Any) -> None:
+        """Buffer an episode's row; write them ROWS_PER_GROUP at a time. (A row group's
+        metadata, kept by the writer until the file closes, is about 0.1 MB for the
+        episodes table's 150 columns: one per episode grew memory with the episodes.)"""
+        self.rows.append(row)
+        if len(self.rows) == ROWS_PER_GROUP:
+            self.flush()
+
+    def flush(self) -> None:
+        if self.rows:
+            self.meta.write_table(tables.pa.concat_tables(self.rows))
+            self.rows.clear()
+
     def close(self) -> None:
+        if self.meta is not None:
+            self.flush()
         for writer in (self.data, self.meta):
             if writer is not None:
                 writer.close()
@@ -204,7 +221,7 @@ class DatasetWriter:
             schema = tables.episodes_schema(stats, sorted(episode.videos))
             path = str(files.temporary(out.meta_path))
             out.meta = tables.pa.parquet.ParquetWriter(path, schema, compression="snappy")
-        out.meta.write_table(tables.episode_row(out.meta.schema, row))
+        out.add_row(tables.episode_row(out.meta.schema, row))
         out.frames += n
         self.stats = merge(self.stats, stats)
         self.episodes, self.frames, self.added = index + 1, self.frames + n, self.added + 1
