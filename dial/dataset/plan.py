@@ -46,6 +46,27 @@ def expected_features(world: World, request: Request) -> dict[str, FeatureJSON]:
     from dial.dataset.robot import robot_names, scene_bodies
 
     bodies = scene_bodies(list(world.objects.values()))
+    if request.cameras:
+        check_cameras(world, request.cameras)
     cameras = dict.fromkeys(request.cameras, CAMERA_SIZE)
     spec = features(robot_names(), bodies, cameras, request.fps)
     return {name: feature.as_json() for name, feature in spec.items()}
+
+
+def check_cameras(world: World, names: tuple[str, ...]) -> None:
+    """A usage error for a camera the scene's model lacks (its model is compiled for it)."""
+    import mujoco
+
+    from dial.backend.model import load_model
+
+    model = load_model(world.model_path)
+    known = [
+        "task",
+        *(mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_CAMERA, i) for i in range(model.ncam)),
+    ]
+    unknown = [n for n in names if n not in known]
+    if unknown:
+        raise OptionError(
+            f"--cameras: the scene {world.name} has no camera '{unknown[0]}' "
+            f"(it has: {', '.join(n for n in known if n)})"
+        )

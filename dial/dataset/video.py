@@ -29,21 +29,11 @@ STATS_EVERY = 5  # frames between the frames the statistics are taken from
 STATS_STRIDE = 4  # and the pixels: every 4th row and column
 
 
-def camera_names(model: mujoco.MjModel) -> list[str]:
-    """The cameras ``--cameras`` accepts in this model: ``task``, and the model's own."""
-    names = [mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_CAMERA, i) for i in range(model.ncam)]
-    return [TASK, *(n for n in names if n)]
-
-
 class Cameras:
     """Renders every named camera at each frame; ``close`` gives the mp4s' bytes."""
 
     def __init__(self, robot: MujocoRobot, world: World, names: Sequence[str], fps: int) -> None:
         model, self.data = robot.model, robot.data
-        known = camera_names(model)
-        unknown = [n for n in names if n not in known]
-        if unknown:
-            raise DialError(f"--cameras: no camera '{unknown[0]}' here (known: {', '.join(known)})")
         height, width = CAMERA_SIZE
         self.sizes = dict.fromkeys(names, CAMERA_SIZE)
         body = mujoco.mjtObj.mjOBJ_BODY
@@ -58,9 +48,10 @@ class Cameras:
             renderer = self.renderers[name] = Renderer(model, view, width, height)
             if name != TASK:
                 renderer.camera.type = mujoco.mjtCamera.mjCAMERA_FIXED
-                renderer.camera.fixedcamid = mujoco.mj_name2id(
-                    model, mujoco.mjtObj.mjOBJ_CAMERA, name
-                )
+                camera = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_CAMERA, name)
+                if camera < 0:  # checked before the run (dial.dataset.plan.check_cameras)
+                    raise DialError(f"--cameras: the scene has no camera '{name}'")
+                renderer.camera.fixedcamid = camera
             self.files[name] = VideoFile(self._path(name), fps)
 
     def _path(self, name: str) -> Path:

@@ -112,6 +112,8 @@ def test_bad_dataset_input_is_one_line_and_changes_nothing(
         (["run", "lightbulb.dial", "--dataset", d], 1, other),
         ([*run, "--dataset", d, "--fps", "25"], 1, "it is at 50 fps, not 25"),
         ([*run, "--dataset", f], 1, f"'{f}' is a file"),
+        ([*run, "--dataset", d, "--cameras", "nope"], 2, "has no camera 'nope' (it has: task)"),
+        ([*run, "--dataset", d, "--cameras", ","], 2, "--cameras: expected camera names"),
     ]
     for argv, status, message in cases:
         got, err = _cli(capsys, *argv)
