@@ -100,7 +100,7 @@ def info_json(writer: DatasetWriter) -> dict[str, object]:
         "total_episodes": writer.episodes,
         "total_frames": writer.frames,
         "total_tasks": len(writer.tasks),
-        "chunks_size": 1000,
+        "chunks_size": writer.chunks_size,
         "data_files_size_in_mb": max(1, math.ceil(writer.file_bytes / 2**20)),
         "video_files_size_in_mb": VIDEO_FILE_MB,
         "data_path": files.DATA_PATH,

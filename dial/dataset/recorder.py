@@ -20,6 +20,7 @@ from dial.dataset.episode import Episode, EpisodeInfo
 from dial.dataset.features import DEFAULT_FPS, Features, features
 from dial.dataset.robot import RobotReader, robot_names, scene_bodies
 from dial.engine.observe import Watched
+from dial.errors import DialError
 
 if TYPE_CHECKING:
     from dial.dataset.video import Cameras
@@ -85,7 +86,9 @@ class Recorder:
         self.reader = RobotReader(robot, self.bodies)
         self.hz = round(1.0 / robot.period)
         if not 1 <= self.fps <= self.hz:
-            raise ValueError(f"--fps must be from 1 to {self.hz}, got {self.fps}")
+            raise DialError(f"--fps must be from 1 to {self.hz}, got {self.fps}")
+        # The periods before the first frame: a resumed run's episode starts where it resumes.
+        self.start = robot.steps // robot.substeps
         if self.camera_names:
             from dial.dataset.video import Cameras
 
@@ -116,7 +119,7 @@ class Recorder:
         if self.pending is not None:
             self.columns.arrays["action"][self.pending] = self.reader.commanded()
             self.pending = None
-        if periods >= self._due(self.frames):
+        if periods - self.start >= self._due(self.frames):
             self._sample()
 
     def _sample(self) -> None:

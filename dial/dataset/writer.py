@@ -29,7 +29,7 @@ from numpy.typing import NDArray
 from dial.dataset import files, tables
 from dial.dataset.episode import Episode
 from dial.dataset.features import MAX_FPS, FeatureJSON, all_features, difference
-from dial.dataset.meta import Existing, info_json, read_existing
+from dial.dataset.meta import info_json, read_existing
 from dial.dataset.stats import FeatureStats, as_json, episode_stats, merge
 from dial.dataset.tables import DatasetError
 
@@ -51,6 +51,7 @@ class _Committed:
     frames: int
     tasks: tuple[str, ...]
     stats: FeatureStats | None
+    features: dict[str, FeatureJSON] | None
 
 
 class _Open:
@@ -134,21 +135,24 @@ class DatasetWriter:
             raise
         self.features: dict[str, FeatureJSON] | None = existing.features
         self.file_bytes = int((file_mb or existing.file_mb or DEFAULT_FILE_MB) * 2**20)
-        self._state = _Committed(existing.episodes, existing.frames, existing.tasks, existing.stats)
+        self.chunks_size = existing.chunks_size or CHUNKS_SIZE
+        self._state = _Committed(
+            existing.episodes, existing.frames, existing.tasks, existing.stats, existing.features
+        )
         self.episodes, self.frames = existing.episodes, existing.frames
         self.tasks, self.stats = list(existing.tasks), existing.stats
         self.added = 0  # episodes added by this writer (committed or not)
         self.last_frames = 0  # the frames of the last episode added
-        self._slots = self._first_slots(existing)
+        self._slots = self._first_slots()
         self._open: _Open | None = None
         self._video_slots: dict[str, tuple[int, int]] = {}
         self._closed = False
 
-    def _first_slots(self, existing: Existing) -> tuple[tuple[int, int], tuple[int, int]]:
+    def _first_slots(self) -> tuple[tuple[int, int], tuple[int, int]]:
         for path in files.stale(self.root):  # a dead writer's: the lock is ours
             files.remove([path])
-        data = files.next_slot(self.root / "data", files_per_chunk(existing))
-        meta = files.next_slot(self.root / "meta" / "episodes", files_per_chunk(existing))
+        data = files.next_slot(self.root / "data", self.chunks_size)
+        meta = files.next_slot(self.root / "meta" / "episodes", self.chunks_size)
         return data, meta
 
     # -- the public interface -------------------------------------------------------------------
@@ -197,14 +201,14 @@ class DatasetWriter:
 
     # -- writing --------------------------------------------------------------------------------
     def _write(self, episode: Episode) -> int:
+        n, index = episode.length, self.episodes
+        if self._open is not None and self._full(n):
+            self.commit()  # before this episode's task is known: it goes with the episode
         if self.features is None:
             self.features = all_features(dict(episode.features))
-        n, index = episode.length, self.episodes
         if episode.task not in self.tasks:
             self.tasks.append(episode.task)
         task = self.tasks.index(episode.task)
-        if self._open is not None and self._full(n):
-            self.commit()
         if self._open is None:
             self._open = _Open(self.root, *self._slots)
         out = self._open
@@ -268,13 +272,13 @@ class DatasetWriter:
         timestamps within a file; a file of its own starts at 0)."""
         slot = self._video_slots.get(key)
         if slot is None:
-            slot = files.next_slot(self.root / "videos" / key, CHUNKS_SIZE)
+            slot = files.next_slot(self.root / "videos" / key, self.chunks_size)
         path = self.root / files.VIDEO.format(key=key, chunk=slot[0], file=slot[1])
         path.parent.mkdir(parents=True, exist_ok=True)
         tmp = files.temporary(path)
         out.written.append((tmp, path))
         tmp.write_bytes(video)
-        self._video_slots[key] = files.following(slot, CHUNKS_SIZE)
+        self._video_slots[key] = files.following(slot, self.chunks_size)
         return slot
 
     # -- commits and rollbacks ------------------------------------------------------------------
@@ -296,8 +300,13 @@ class DatasetWriter:
                 tmp.replace(final)
         self._open = None
         data, meta = self._slots
-        self._slots = (files.following(data, CHUNKS_SIZE), files.following(meta, CHUNKS_SIZE))
-        self._state = _Committed(self.episodes, self.frames, tuple(self.tasks), self.stats)
+        self._slots = (
+            files.following(data, self.chunks_size),
+            files.following(meta, self.chunks_size),
+        )
+        self._state = _Committed(
+            self.episodes, self.frames, tuple(self.tasks), self.stats, self.features
+        )
 
     @contextmanager
     def _or_rollback(self) -> Iterator[None]:
@@ -321,12 +330,8 @@ class DatasetWriter:
             [files.temporary(self.root / p) for p in (files.INFO, files.STATS, files.TASKS)]
         )
         s = self._state
-        self.episodes, self.frames, self.tasks, self.stats = (
-            s.episodes,
-            s.frames,
-            list(s.tasks),
-            s.stats,
-        )
+        self.episodes, self.frames, self.stats = s.episodes, s.frames, s.stats
+        self.tasks, self.features = list(s.tasks), s.features
         self._video_slots.clear()
         self._unmake_if_empty()
 
@@ -360,10 +365,6 @@ class DatasetWriter:
         """Remove the folders this writer made, while they are empty."""
         if self._made is not None and self._made != self.root:
             files.prune(self.root, self._made)
-
-
-def files_per_chunk(existing: Existing) -> int:
-    return existing.chunks_size or CHUNKS_SIZE
 
 
 def _index_columns(table: Any) -> dict[str, NDArray[np.generic]]:

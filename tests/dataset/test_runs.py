@@ -82,6 +82,16 @@ def test_a_custom_sweep_appends_episodes_through_one_writer(tmp_path: Path) -> N
     assert layout.check(tmp_path)["info"]["total_episodes"] == 2
 
 
+def test_a_resumed_runs_episode_starts_where_it_resumes(tmp_path: Path) -> None:
+    dial.run(SCRIPT, save_at=(2, tmp_path / "s.state"))
+    result = dial.run(SCRIPT, resume=tmp_path / "s.state", dataset=tmp_path / "d")
+    resumed = result.log.of("resume")[0]
+    periods = round((result.summary.sim_time - float(resumed["t"])) * 100)  # type: ignore[arg-type]
+    frames = _frames(tmp_path / "d")["frame_index"]
+    assert len(frames) == periods // 2 + 1  # 50 fps: every other period, and the first
+    layout.check(tmp_path / "d")
+
+
 def test_an_interrupted_run_writes_no_episode(tmp_path: Path) -> None:
     def stop(tick: int, t: float, running: list[str]) -> None:
         if tick == 3:

@@ -225,3 +225,19 @@ def test_the_checker_catches_what_lerobots_reader_lets_through(tmp_path: Path) -
         pq.write_table(table, path)
         with pytest.raises(AssertionError):
             layout.check(root)
+
+
+def test_a_task_is_committed_with_its_first_episode(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The episode that fills a data file commits the file; a new task of the next episode,
+    whose write then fails, is not in the dataset."""
+    from dataclasses import replace
+
+    _fail_at(monkeypatch, tables, "frames_table", 1)
+    with pytest.raises(DatasetError), DatasetWriter(tmp_path / "d", file_mb=0.0001) as writer:
+        writer.add(fake_episode(seed=1))
+        writer.add(replace(fake_episode(seed=2), task="another task"))
+    read = layout.check(tmp_path / "d")
+    assert read["info"]["total_episodes"] == 1
+    assert read["tasks"] == {0: "fake.dial in scene nowhere"}
