@@ -149,8 +149,7 @@ def run(
     from dial.engine import run as run_engine
 
     stops, console = _pausing(script, breaks, step, console)
-    moved = saved.settings.perturb_mm if saved is not None else perturb
-    with _log_sink(log) as sink, _recording(dataset, request, script, moved) as recorder:
+    with _log_sink(log) as sink, _recording(dataset, request, script, saved, perturb) as recorder:
         options = RunOptions(
             tick=tick,
             speed=speed,
@@ -222,15 +221,18 @@ def _recording(
     dataset: str | Path | DatasetWriter | None,
     request: Request | None,
     script: Script,
+    saved: Saved | None,
     perturb_mm: float,
 ) -> Iterator[list[Observer]]:
-    """The dataset's recorder as a list of observers (empty without ``dataset=``)."""
+    """The dataset's recorder as a list of observers (empty without ``dataset=``); a
+    resumed run's perturbation is its state file's."""
     if dataset is None or request is None:
         yield []
         return
     from dial.dataset.session import recording
 
-    with recording(dataset, request, script, perturb_mm) as recorder:
+    moved = saved.settings.perturb_mm if saved is not None else perturb_mm
+    with recording(dataset, request, script, moved) as recorder:
         yield [recorder]
 
 

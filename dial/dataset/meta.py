@@ -5,15 +5,11 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 from dial.dataset import files, tables
 from dial.dataset.features import FeatureJSON
 from dial.dataset.stats import FeatureStats, from_json
 from dial.dataset.tables import DatasetError
-
-if TYPE_CHECKING:
-    from dial.dataset.writer import DatasetWriter
 
 CODEBASE_VERSION = "v3.0"
 VIDEO_FILE_MB = 200  # LeRobot's default; dial writes one video file per episode and camera
@@ -89,22 +85,35 @@ def _read_tasks(root: Path) -> tuple[str, ...]:
     return tuple(str(task) for _, task in pairs)
 
 
-def info_json(writer: DatasetWriter) -> dict[str, object]:
-    """info.json as of the writer's state, in LeRobot's key order."""
-    features = writer.features or {}
+@dataclass(frozen=True)
+class Totals:
+    """What info.json says of a dataset beside its features (a writer's state)."""
+
+    fps: int
+    episodes: int
+    frames: int
+    tasks: int
+    chunks_size: int
+    file_bytes: int
+    robot_type: str
+
+
+def info_json(features: dict[str, FeatureJSON] | None, totals: Totals) -> dict[str, object]:
+    """info.json, in LeRobot's key order."""
+    features = features or {}
     videos = [name for name, f in features.items() if f["dtype"] == "video"]
     return {
         "codebase_version": CODEBASE_VERSION,
-        "fps": writer.fps,
+        "fps": totals.fps,
         "features": features,
-        "total_episodes": writer.episodes,
-        "total_frames": writer.frames,
-        "total_tasks": len(writer.tasks),
-        "chunks_size": writer.chunks_size,
-        "data_files_size_in_mb": max(1, math.ceil(writer.file_bytes / 2**20)),
+        "total_episodes": totals.episodes,
+        "total_frames": totals.frames,
+        "total_tasks": totals.tasks,
+        "chunks_size": totals.chunks_size,
+        "data_files_size_in_mb": max(1, math.ceil(totals.file_bytes / 2**20)),
         "video_files_size_in_mb": VIDEO_FILE_MB,
         "data_path": files.DATA_PATH,
         "video_path": files.VIDEO_PATH if videos else None,
-        "robot_type": writer.robot_type,
-        "splits": {"train": f"0:{writer.episodes}"},
+        "robot_type": totals.robot_type,
+        "splits": {"train": f"0:{totals.episodes}"},
     }

@@ -29,7 +29,7 @@ from numpy.typing import NDArray
 from dial.dataset import files, tables
 from dial.dataset.episode import Episode
 from dial.dataset.features import MAX_FPS, FeatureJSON, all_features, difference
-from dial.dataset.meta import info_json, read_existing
+from dial.dataset.meta import Totals, info_json, read_existing
 from dial.dataset.stats import FeatureStats, as_json, episode_stats, merge
 from dial.dataset.tables import DatasetError
 
@@ -295,7 +295,17 @@ class DatasetWriter:
             tables.pa.parquet.write_table(tables.tasks_table(self.tasks), str(written[-1][0]))
             stats_json = as_json(self.stats or {})
             written.append((files.write_json(stats, stats_json, indent=None), stats))
-            written.append((files.write_json(info, info_json(self)), info))  # the last
+            totals = Totals(
+                self.fps,
+                self.episodes,
+                self.frames,
+                len(self.tasks),
+                self.chunks_size,
+                self.file_bytes,
+                self.robot_type,
+            )
+            info_text = info_json(self.features, totals)
+            written.append((files.write_json(info, info_text), info))  # the last
             for tmp, final in written:
                 tmp.replace(final)
         self._open = None
