@@ -115,17 +115,33 @@ def body_names(model: mujoco.MjModel) -> list[str]:
     return entity_names(model, mujoco.mjtObj.mjOBJ_BODY, model.nbody, "body")
 
 
-GROUPS = (("puma_", "arm/"), ("hand_", "hand/"))  # body-name prefix -> entity group
+Groups = tuple[tuple[str, str], ...]  # body-name prefix -> entity group
+GROUPS: Groups = (("puma_", "arm/"), ("hand_", "hand/"))  # the first robot's
 
 
-def body_paths(model: mujoco.MjModel, objects: Mapping[str, str]) -> list[str]:
+def name_groups(arm_joint: str, hand_joint: str) -> Groups:
+    """A robot's groups, from the prefixes of its arm's and its hand's joint names: the word
+    before the first ``_`` (``puma_``, ``hand_``; ``panda_``, ``allegro_``); none for a name
+    without one."""
+    groups = []
+    for name, group in ((arm_joint, "arm/"), (hand_joint, "hand/")):
+        head, sep, _ = name.partition("_")
+        if sep:
+            groups.append((head + sep, group))
+    return tuple(groups)
+
+
+def body_paths(
+    model: mujoco.MjModel, objects: Mapping[str, str], groups: Groups = GROUPS
+) -> list[str]:
     """Each body's entity path under ``world``, readable on hover: ``arm/link2``,
-    ``hand/index_distal``, a scene object by its alias (``bulb``; ``objects`` maps aliases to
-    body names), ``scene/<body>`` for the rest, and ``scene/static`` for the world body."""
+    ``hand/index_distal`` (``groups``' prefixes), a scene object by its alias (``bulb``;
+    ``objects`` maps aliases to body names), ``scene/<body>`` for the rest, and
+    ``scene/static`` for the world body."""
     alias = {body: name for name, body in objects.items()}
     paths = []
     for i, name in enumerate(body_names(model)):
-        group = next((g + name[len(p) :] for p, g in GROUPS if name.startswith(p)), None)
+        group = next((g + name[len(p) :] for p, g in groups if name.startswith(p)), None)
         paths.append("scene/static" if i == 0 else alias.get(name) or group or f"scene/{name}")
     return paths
 
