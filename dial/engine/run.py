@@ -20,6 +20,7 @@ from dial.backend.driver import MujocoRobot
 from dial.backend.snapshot import Snapshot
 from dial.debug import Break, Console, Session
 from dial.disturb import Disturbance, parse_disturbance
+from dial.engine.beliefs import believed_world, journal
 from dial.engine.debugging import session
 from dial.engine.observe import Observer, StateLog, Watched, describe, fan_out, first_line
 from dial.engine.result import RunResult, measure_criteria
@@ -59,6 +60,7 @@ class RunOptions:
     console: Console | None = None
     save_at: tuple[int, Path] | None = None  # (block number, state file)
     resume: Saved | None = None  # a state file to go on from (its settings win)
+    follow_grasps: bool = True  # grasped objects follow the hand in the world model
 
 
 def tick_length(script: Script, options: RunOptions) -> float:
@@ -86,7 +88,9 @@ def run(script: Script, options: RunOptions) -> RunResult:
         log = EventLog(options.log)
         settings = _settings(script, options)
         disturb = [parse_disturbance(d) for d in settings.disturb]
-        robot, ctx = prepare(script, log, settings.perturb_mm, settings.seed, disturb)
+        robot, ctx = prepare(
+            script, log, settings.perturb_mm, settings.seed, disturb, options.follow_grasps
+        )
         resume = _resume(script, options.resume, robot, ctx, log)
         states = [StateLog(lanes=LanePlan.from_script(script))] if options.log_states else []
         begun: list[Observer] = []
@@ -106,9 +110,11 @@ def run(script: Script, options: RunOptions) -> RunResult:
                 stop=stop,
             )
             hooks = runner.hooks = _debugging(script, runner, ctx, stop, settings, begun, options)
+            ctx.world_model.journal = journal(log, runner)
             start, cpu = time.perf_counter(), time.process_time()
             summary = trio.run(runner.run, script, resume)
             wall, cpu = time.perf_counter() - start, time.process_time() - cpu
+            believed_world(log, ctx, summary.ticks)
             result = RunResult(
                 summary,
                 ctx.world,

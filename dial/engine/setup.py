@@ -19,6 +19,7 @@ from dial.disturb import Disturbance
 from dial.geometry import Pose, location_pose, rpy_matrix
 from dial.parser.script import Script
 from dial.primitives import Context
+from dial.scene.belief import Beliefs, initial
 from dial.scene.of_script import script_world
 from dial.scene.resolve import worlds_dir
 from dial.scene.thread import set_turns
@@ -71,8 +72,10 @@ def prepare(
     perturb_mm: float = 0.0,
     seed: int = 0,
     disturbances: Sequence[Disturbance] = (),
+    follow: bool = True,
 ) -> tuple[MujocoRobot, Context]:
-    """Load the scene, place the robot at home, perturb, settle; log the ``scene`` record."""
+    """Load the scene, place the robot at home, perturb, settle; log the ``scene`` record.
+    ``follow=False``: grasped objects do not follow the hand in the world model."""
     world = script_world(script)
     model = load_model(world.model_path)
     set_turns(model, world)
@@ -80,10 +83,11 @@ def prepare(
     index = RobotIndex.from_model(model)
     unmoved = mujoco.MjData(model)
     mujoco.mj_forward(model, unmoved)
-    believed: dict[str, Pose] = {
+    at_load: dict[str, Pose] = {
         model.body(b).name: (unmoved.xpos[b].copy(), unmoved.xmat[b].reshape(3, 3).copy())
         for b in scene_bodies(model, world)
     }
+    believed, sizes = initial(world, at_load)
     shift = perturb(model, world, perturb_mm, seed)
     data = mujoco.MjData(model)
     ik = ArmIK()
@@ -104,4 +108,5 @@ def prepare(
     where = world.path.name if bundled else str(world.path)
     log.write("scene", scene=world.name, world=where, perturb=shift, seed=seed)
     robot = MujocoRobot(model, data, disturbances=placed)
-    return robot, Context(robot, world, believed, ik)
+    beliefs = Beliefs(world, believed, sizes, follow=follow)
+    return robot, Context(robot, world, believed, ik, beliefs=beliefs)

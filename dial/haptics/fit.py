@@ -53,13 +53,16 @@ class PlaneFit:
     ``normal`` (3,) is a unit vector in the hemisphere of the ``up`` vector given to
     :func:`fit_plane`. ``axes`` (2, 3) holds the in-plane principal directions as rows, the
     direction of largest spread first, with ``axes[0] x axes[1] = normal``. ``extents`` (2,)
-    is max - min of the points projected on each axis. Residuals are distances off the plane.
+    is max - min of the points projected on each axis, and ``centre`` (3,) the point of the
+    plane halfway between those extremes: the middle of a traced face. Residuals are distances
+    off the plane.
     """
 
     centroid: Array
     normal: Array
     axes: Array
     extents: Array
+    centre: Array
     rms_residual: float
     max_residual: float
     count: int
@@ -70,6 +73,7 @@ class PlaneFit:
             "normal": _floats(self.normal),
             "extents": _floats(self.extents),
             "centroid": _floats(self.centroid),
+            "centre": _floats(self.centre),
             "axes": [_floats(a) for a in self.axes],
             "rms_residual": self.rms_residual,
             "max_residual": self.max_residual,
@@ -139,6 +143,7 @@ def fit_plane(points: npt.ArrayLike, up: npt.ArrayLike = (0.0, 0.0, 1.0)) -> Pla
         normal=_frozen(normal),
         axes=_frozen(axes),
         extents=_frozen(along.max(axis=0) - along.min(axis=0)),
+        centre=_frozen(centroid + axes.T @ ((along.max(axis=0) + along.min(axis=0)) / 2.0)),
         rms_residual=float(np.sqrt(np.mean(off**2))),
         max_residual=float(np.max(np.abs(off))),
         count=len(p),

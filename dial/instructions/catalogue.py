@@ -124,6 +124,24 @@ def _guarded(args: Args, scene: SceneNames | None) -> frozenset[str]:
     return _arm(args, scene) if args.get("finger") is None else _finger(args, scene)
 
 
+def _fit(name: str, what: str) -> Instruction:
+    """``fit_plane`` or ``fit_superquadric``: a least-squares ``what``."""
+    doc = "the object the points lie on: the fit becomes its believed pose and size"
+    return Instruction(
+        name,
+        "zero",
+        (
+            ParamSpec("set", Name("set"), "contacts", positional=True),
+            ParamSpec("object", Name("object"), None, doc=doc),
+        ),
+        _none,
+        f"{name} [SET] [object=OBJECT]",
+        f"Least-squares {what}.",
+        sensing=True,
+        primitive="Fit",
+    )
+
+
 def _check_puma(args: Args) -> str | None:
     if args.get("verb") != "drive":
         return None
@@ -361,26 +379,8 @@ INSTRUCTIONS: dict[str, Instruction] = {
             sensing=True,
             primitive="Locate",
         ),
-        Instruction(
-            "fit_plane",
-            "zero",
-            (ParamSpec("set", Name("set"), "contacts", positional=True),),
-            _none,
-            "fit_plane [SET]",
-            "Least-squares plane through a point set: normal, residual, extents.",
-            sensing=True,
-            primitive="Fit",
-        ),
-        Instruction(
-            "fit_superquadric",
-            "zero",
-            (ParamSpec("set", Name("set"), "contacts", positional=True),),
-            _none,
-            "fit_superquadric [SET]",
-            "Least-squares superquadric through a point set: size, shape exponents, pose.",
-            sensing=True,
-            primitive="Fit",
-        ),
+        _fit("fit_plane", "plane through a point set: normal, residual, extents"),
+        _fit("fit_superquadric", "superquadric through a point set: size, shape exponents, pose"),
     )
 }
 

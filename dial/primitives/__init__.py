@@ -42,6 +42,10 @@ def make_factory(ctx: Context) -> PrimitiveFactory[Snapshot]:
     """The runner's factory: a fresh primitive (or sensor) per run."""
 
     def factory(info: RunInfo) -> Made:
+        # Before each run, the world model carries what the hand holds to where the tool is,
+        # and lets go of what the fingers no longer touch (nothing to do while nothing is held).
+        if ctx.world_model.held:
+            ctx.refresh(ctx.robot.time)
         made = CLASSES[info.event.instruction.primitive](ctx, info)
         if info.instant and isinstance(made, ContactWait):
             return _Test(made)  # a contact wait tested as a condition: is it there now?

@@ -6,9 +6,11 @@ from dataclasses import dataclass, field
 
 from dial.backend.driver import MujocoRobot
 from dial.backend.ik import ArmIK, FingerIK
+from dial.backend.locate import fingers_touching
 from dial.backend.slots import Slots
 from dial.backend.snapshot import FloatArray, Snapshot
 from dial.geometry import Pose, location_pose
+from dial.scene.belief import Beliefs
 from dial.scene.world import World
 from dial.scheduler.types import Ended, Outcome, Primitive, RunInfo
 
@@ -32,7 +34,9 @@ class Context:
 
     ``believed`` holds each object's pose as the world model believes it
     (position (3,), rotation (3, 3)); with ``--perturb`` the true pose in the
-    physics differs, and only sensing can make up the difference.
+    physics differs, and only sensing can make up the difference. ``beliefs`` is the
+    world model around it (sizes, held objects, the log of its changes:
+    :mod:`dial.scene.belief`).
     """
 
     robot: MujocoRobot
@@ -44,9 +48,36 @@ class Context:
     # finger -> where it touched when the latest guarded move sensing it stopped on contact
     stops: dict[int, StopContact] = field(default_factory=dict)
     results: dict[str, dict[str, object]] = field(default_factory=dict)
+    beliefs: Beliefs | None = None  # made from world and believed when not given
+
+    def __post_init__(self) -> None:
+        if self.beliefs is None:
+            self.beliefs = Beliefs(self.world, self.believed)
+
+    @property
+    def world_model(self) -> Beliefs:
+        """The world model (``beliefs``, always set after construction)."""
+        assert self.beliefs is not None
+        return self.beliefs
 
     def location(self, name: str) -> Pose:
+        """A location's tool pose, relative objects where the world model believes them now
+        (a held one where the tool has carried it)."""
+        self.refresh(self.robot.time)
         return location_pose(self.world, self.believed, name)
+
+    def tool(self) -> Pose:
+        """The commanded tool pose: where the planner starts the next motion from."""
+        return self.arm_ik.fk(self.robot.arm_target)
+
+    def touching(self, body: str, fingers: tuple[int, ...]) -> int:
+        """How many of ``fingers`` touch the object ``body`` now."""
+        return fingers_touching(self.robot.model, self.robot.data, body, fingers)
+
+    def refresh(self, t: float) -> None:
+        """Carry the held objects to where the tool is, releasing those let go of."""
+        if self.world_model.held:
+            self.world_model.update(self.tool(), self.touching, t)
 
 
 class RobotPrimitive(Primitive[Snapshot]):

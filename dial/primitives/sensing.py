@@ -139,11 +139,17 @@ class Locate:
         tool, _ = self.ctx.arm_ik.fk(snapshot.arm_target)
         shift = tool - self.ctx.location(self.location)[0]
         aliases = {b: a for a, b in world.objects.items()}
-        bodies = dict.fromkeys([body, *(world.objects[a] for a in self.also)])
-        for b in bodies:
-            pos, rot = self.ctx.believed[b]
-            self.ctx.believed[b] = (pos + shift, rot)
+        bodies = tuple(dict.fromkeys([body, *(world.objects[a] for a in self.also)]))
+        self.ctx.world_model.locate(bodies, shift, snapshot.time, self.location_object())
         return done(shift=shift, objects=[aliases.get(b, b) for b in bodies])
+
+    def location_object(self) -> str:
+        """The alias the location is written relative to."""
+        return next(
+            (a for a, b in self.ctx.world.objects.items()
+             if b == self.ctx.world.locations[self.location].body),
+            "",
+        )  # fmt: skip
 
 
 class Fit:
@@ -153,6 +159,8 @@ class Fit:
         self.ctx = ctx
         self.set = str(info.event.args["set"])
         self.kind = info.event.instruction.name
+        alias = info.event.args.get("object")
+        self.object = None if alias is None else str(alias)
 
     def sense(self, snapshot: Snapshot) -> Ended:
         points = np.array(self.ctx.point_sets.get(self.set, []), dtype=np.float64).reshape(-1, 3)
@@ -162,4 +170,9 @@ class Fit:
             return Ended(Outcome.MISSED, f"point set '{self.set}': {e}")
         result = fit.as_result()
         self.ctx.results[self.set] = result
+        if self.object is not None:  # the object measured: the world model learns it
+            body, model = self.ctx.world.objects[self.object], self.ctx.world_model
+            self.ctx.refresh(snapshot.time)
+            learn = model.learn_plane if self.kind == "fit_plane" else model.learn_superquadric
+            learn(body, result, snapshot.time, self.object)
         return done(set=self.set, points=len(points), **result)
