@@ -129,14 +129,19 @@ def run(
     save_at: tuple[int, str | Path] | None = None,
     resume: str | Path | None = None,
     console: Console | None = None,
+    save_world: str | Path | None = None,
+    follow_grasps: bool = True,
 ) -> RunResult:
     """Run a script in its scene, as ``dial run`` does, and return its :class:`RunResult`.
 
     ``script``: a :class:`Script` from :func:`load`, or a path or bundled name to load (with
     ``scene``). The keywords are ``dial run``'s options, each described in docs/api.md. A
     stop signal (SIGINT, SIGTERM) ends the run cleanly: ``result.summary.interrupted``.
+    ``follow_grasps=False`` keeps grasped objects where the world model believed them, as
+    before the world model followed the hand (for comparisons).
     """
     items, saved = _checked(tick, speed, seed, perturb, disturb, save_at, resume)
+    world_file = None if save_world is None else _world_file(save_world)
     _check_watching(record, video, rerun, viewer)  # before the script: usage comes first
     script = _script(script, scene)
     from dial.engine import RunOptions
@@ -160,8 +165,25 @@ def run(
             console=console,
             save_at=None if save_at is None else (save_at[0], Path(save_at[1])),
             resume=saved,
+            follow_grasps=follow_grasps,
         )
-        return run_engine(script, options)
+        result = run_engine(script, options)
+    if world_file is not None:
+        from dial.teach.believed import save_world as write_believed
+
+        note = f"The believed world at the end of `dial run {Path(script.path).name}`."
+        write_believed(result.world, result.believed, world_file, note)
+    return result
+
+
+def _world_file(path: str | Path) -> Path:
+    """``--save-world F.toml``: a usage error, before anything runs, if F cannot be written."""
+    if Path(path).suffix.lower() != ".toml":
+        raise OptionError(f"--save-world writes a world file (.toml), not '{path}'")
+    try:
+        return writable(path, "the world file")
+    except DialError as e:
+        raise OptionError(f"--save-world: {e}") from None
 
 
 def _checked(

@@ -57,6 +57,13 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         "[for=D]' (tactile, force or position reads as untouched); see docs/language.md",
     )
     p.add_argument("--log", metavar="FILE.jsonl", help="write the event log as JSON Lines")
+    p.add_argument(
+        "--save-world",
+        metavar="F.toml",
+        help="at the end, write the world file with every object where the world model "
+        "believes it (and its size, once measured), comments kept; 'dial world F.toml' "
+        "shows it and a script run in it starts from it",
+    )
     p.add_argument("--json", action="store_true", help="print a JSON summary as the last line")
     p.add_argument("--quiet", action="store_true", help="no progress and no summary table")
     p.add_argument("--realtime", action="store_true", help="pace the run to wall-clock time")
@@ -149,6 +156,7 @@ def _run(args: argparse.Namespace, stop: StopRequest) -> int:
         step=args.step,
         save_at=save_at,
         resume=args.resume,
+        save_world=args.save_world,
     )
     for number, target in result.saved:
         print(f"dial: saved the state before block {number} to {target}", file=sys.stderr)

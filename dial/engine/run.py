@@ -128,6 +128,7 @@ def run(script: Script, options: RunOptions) -> RunResult:
                 settings.disturb,
                 tuple(hooks.saved) if hooks is not None else (),
                 hooks.unsaved if hooks is not None else None,
+                {body: ctx.world_model.entry(body) for body in ctx.world.objects.values()},
             )
             log.write("summary", **result.as_record())
             return result

@@ -173,6 +173,8 @@ class Fit:
         if self.object is not None:  # the object measured: the world model learns it
             body, model = self.ctx.world.objects[self.object], self.ctx.world_model
             self.ctx.refresh(snapshot.time)
-            learn = model.learn_plane if self.kind == "fit_plane" else model.learn_superquadric
-            learn(body, result, snapshot.time, self.object)
+            if self.kind == "fit_plane":
+                model.learn_plane(body, result, snapshot.time, self.object)
+            else:
+                model.learn_superquadric(body, result, points, snapshot.time, self.object)
         return done(set=self.set, points=len(points), **result)

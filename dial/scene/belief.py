@@ -31,6 +31,10 @@ from dial.scene.world import World
 
 Journal = Callable[[dict[str, object]], None]
 Touching = Callable[[str, tuple[int, ...]], int]  # (body, fingers) -> how many touch it
+# A fit's contacts lie around its centre along an axis when their midrange is within this
+# fraction of their extent from it (a solid touched all round, or on its top and at its bottom
+# edge; not one touched from one side, or from the top down to below its middle only).
+AROUND = 0.1
 
 
 @dataclass(frozen=True)
@@ -164,17 +168,29 @@ class Beliefs:
             pos, rot = self.poses[body]
             self.set(body, (pos + shift, rot), t, "locate", name=name if body == bodies[0] else "")
 
-    def learn_superquadric(self, body: str, fit: Mapping[str, object], t: float, name: str) -> None:
-        """The fitted superquadric is the object: its origin at the fitted centre, its size the
-        fitted half-sizes, each taken along the body axis closest to the fitted axis. The
+    def learn_superquadric(
+        self, body: str, fit: Mapping[str, object], points: FloatArray, t: float, name: str
+    ) -> None:
+        """The fitted superquadric is the object: its size the fitted half-sizes, each taken
+        along the body axis closest to the fitted axis, and its origin at the fitted centre
+        along each body axis on which the contacts ``points`` (N, 3) lie around that centre:
+        their midrange along the axis within ``AROUND`` of their extent from it. Along an axis
+        on which they do not (the bottom of a solid on its stand is never touched, so along
+        the vertical the contacts run from the top to the bottom edge only), the fit closes
+        the shape by its own assumptions, and the believed position along it stays. The
         believed orientation is kept: a symmetric solid's fitted axes are ambiguous (a
         cylinder's about its own axis), and the fits measure where an object is and how
         large, not how it turned."""
         centre = _vector(fit["centre"])
         axes = np.array(fit["rotation"], dtype=np.float64)
         half = _vector(fit["size"])
-        _, rot = self.poses[body]
-        self.set(body, (centre, rot), t, "fit_superquadric", _along(rot, axes, half), name)
+        pos, rot = self.poses[body]
+        along = (np.asarray(points, dtype=np.float64) - centre) @ rot  # body axes
+        low, high = along.min(axis=0), along.max(axis=0)
+        around = np.abs(low + high) / 2.0 <= AROUND * (high - low)
+        new = pos + rot @ np.where(around, rot.T @ (centre - pos), 0.0)
+        size = half[_closest(rot, axes)]
+        self.set(body, (new, rot), t, "fit_superquadric", size, name)
 
     def learn_plane(self, body: str, fit: Mapping[str, object], t: float, name: str) -> None:
         """A fitted plane is a face of the object, and the traced points span it edge to edge:
@@ -199,14 +215,14 @@ def _vector(value: object) -> FloatArray:
     return np.array(value, dtype=np.float64).reshape(-1)
 
 
-def _along(rot: FloatArray, axes: FloatArray, half: FloatArray) -> FloatArray:
-    """Half-sizes ``half`` along the columns of ``axes``, re-expressed along the body axes
-    (the columns of ``rot``): each body axis takes the size of the fitted axis closest to it."""
+def _closest(rot: FloatArray, axes: FloatArray) -> list[int]:
+    """For each body axis (the columns of ``rot``), the fitted axis (a column of ``axes``)
+    closest to it, each fitted axis used once: the best-aligned body axis chooses first."""
     closeness = np.abs(rot.T @ axes)  # [body axis, fitted axis]
-    out = np.empty(3)
+    out = [0, 0, 0]
     taken: set[int] = set()
-    for i in np.argsort(-closeness.max(axis=1)):  # the best-aligned body axis chooses first
+    for i in np.argsort(-closeness.max(axis=1)):
         j = max((j for j in range(3) if j not in taken), key=lambda j: closeness[i, j])
         taken.add(j)
-        out[i] = half[j]
+        out[int(i)] = j
     return out
