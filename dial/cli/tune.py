@@ -6,7 +6,13 @@ import argparse
 from pathlib import Path
 
 from dial import api
-from dial.cli.common import UsageError, at_least, scene_argument, sigterm_as_interrupt
+from dial.cli.common import (
+    UsageError,
+    at_least,
+    load_script,
+    scene_argument,
+    sigterm_as_interrupt,
+)
 from dial.disturb import parse_disturbance
 from dial.instructions.scene_names import SceneNotFoundError
 
@@ -26,9 +32,9 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
     scene_argument(p)
     p.add_argument(
         "--ticks",
-        required=True,
         metavar="A:B:N",
-        help="N tick lengths from A to B s inclusive, linearly spaced (e.g. 0.05:0.5:10)",
+        help="N tick lengths from A to B s inclusive, linearly spaced (e.g. 0.05:0.5:10); "
+        "default: the script's own tick (@tick, else 0.25 s)",
     )
     p.add_argument("--trials", type=int, default=1, metavar="K", help="trials per tick length")
     p.add_argument(
@@ -76,7 +82,7 @@ def cmd_tune(args: argparse.Namespace) -> int:
     from dial.tune import ProcessExecutor, TuneOptions, models, parse_ticks, tune
 
     try:
-        ticks = parse_ticks(args.ticks)
+        ticks = parse_ticks(args.ticks) if args.ticks is not None else None
     except ValueError as e:
         raise UsageError(f"--ticks: {e}") from None
     at_least("--trials", args.trials, 1)
@@ -92,6 +98,10 @@ def cmd_tune(args: argparse.Namespace) -> int:
         scene = None if args.scene is None else scene_option(args.scene)
     except SceneNotFoundError as e:
         raise UsageError(str(e)) from None
+    if ticks is None:  # the script's own tick: it is checked here, as the sweep would
+        from dial.engine.run import DEFAULT_TICK
+
+        ticks = (load_script(args.script, scene).tick or DEFAULT_TICK,)
     options = TuneOptions(
         script=args.script,
         scene=scene,

@@ -192,6 +192,7 @@ def save(
                 "fingers": list(held.fingers),
                 "relative": [_array(held.relative[0]), _array(held.relative[1])],
                 "grasped": [_array(held.grasped[0]), _array(held.grasped[1])],
+                "on": held.on,
             }
             for body, held in ctx.world_model.held.items()
         },
@@ -333,7 +334,8 @@ def _restore_beliefs(d: dict[str, Any], ctx: Context) -> None:
                 held["relative"], held["grasped"]
             )
         )  # fmt: skip
-        model.held[body] = Held(tuple(int(f) for f in held["fingers"]), relative, grasped)
+        fingers = tuple(int(f) for f in held["fingers"])
+        model.held[body] = Held(fingers, relative, grasped, str(held.get("on", "")))
 
 
 def load(source: Path) -> Saved:

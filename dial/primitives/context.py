@@ -6,7 +6,7 @@ from dataclasses import dataclass, field
 
 from dial.backend.driver import MujocoRobot
 from dial.backend.ik import ArmIK, FingerIK
-from dial.backend.locate import fingers_touching
+from dial.backend.locate import fingers_touching, resting_on
 from dial.backend.slots import Slots
 from dial.backend.snapshot import FloatArray, Snapshot
 from dial.geometry import Pose, location_pose
@@ -73,6 +73,10 @@ class Context:
     def touching(self, body: str, fingers: tuple[int, ...]) -> int:
         """How many of ``fingers`` touch the object ``body`` now."""
         return fingers_touching(self.robot.model, self.robot.data, body, fingers)
+
+    def resting(self, body: str) -> tuple[str, ...]:
+        """The bodies resting on the object ``body`` now."""
+        return resting_on(self.robot.model, self.robot.data, body)
 
     def refresh(self, t: float) -> None:
         """Carry the held objects to where the tool is, releasing those let go of."""

@@ -83,9 +83,9 @@ class GraspForce(RobotPrimitive):
         self.target[:] = q
         self.slots.joints(self.jmask, self.target)
         if self.monitored <= stopped.keys():
-            self.ctx.world_model.grasp(
-                self.ctx.tool(), tuple(self.fingers), self.ctx.touching, now.sim_time
-            )
+            ctx = self.ctx
+            fingers = tuple(self.fingers)
+            ctx.world_model.grasp(ctx.tool(), fingers, ctx.touching, ctx.resting, now.sim_time)
             return done(forces=self._forces(diff))
         if all(q[k] >= limits[k] for k in closing) and not (self.monitored & stopped.keys()):
             message = "the fingers closed fully without reaching the force"

@@ -31,6 +31,7 @@ from dial.scene.world import World
 
 Journal = Callable[[dict[str, object]], None]
 Touching = Callable[[str, tuple[int, ...]], int]  # (body, fingers) -> how many touch it
+Resting = Callable[[str], tuple[str, ...]]  # body -> the bodies resting on it (above it)
 # A fit's contacts lie around its centre along an axis when their midrange is within this
 # fraction of their extent from it (a solid touched all round, or on its top and at its bottom
 # edge; not one touched from one side, or from the top down to below its middle only).
@@ -40,11 +41,13 @@ AROUND = 0.1
 @dataclass(frozen=True)
 class Held:
     """An object in the hand: the fingers that grasped it, its believed pose in the
-    (commanded) tool frame, and its believed pose when it was grasped."""
+    (commanded) tool frame, and its believed pose when it was grasped; ``on``: the held
+    object it rests on (a lid on a grasped pitcher), "" for an object the fingers hold."""
 
     fingers: tuple[int, ...]
     relative: Pose
     grasped: Pose
+    on: str = ""
 
 
 def compose(a: Pose, b: Pose) -> Pose:
@@ -135,31 +138,51 @@ class Beliefs:
         self._note(body, why, before, t, name)
 
     # -- grasps ------------------------------------------------------------------------------
-    def grasp(self, tool: Pose, fingers: tuple[int, ...], touching: Touching, t: float) -> None:
+    def grasp(
+        self,
+        tool: Pose,
+        fingers: tuple[int, ...],
+        touching: Touching,
+        resting: Resting,
+        t: float,
+    ) -> None:
         """A grasp with ``fingers`` ended done: every object that two of them (its one finger)
-        touch is held from now on, at its believed pose in the tool frame ``tool``."""
+        touch is held from now on, at its believed pose in the tool frame ``tool``, and so is
+        every object resting on it (the home-robot seed's ownership: a lid on a pitcher)."""
         if not self.follow:
             return
         self.update(tool, touching, t)
         need = min(2, len(fingers))
-        for body in dict.fromkeys(self.world.objects.values()):
+        objects = dict.fromkeys(self.world.objects.values())
+        for body in objects:
             if body in self.held or touching(body, fingers) < need:
                 continue
-            pose = self.poses[body]
-            self.held[body] = Held(fingers, compose(inverse(tool), pose), pose)
-            self._note(body, "grasped", self.entry(body), t, "")
+            self._hold(body, Held(fingers, self._in(tool, body), self.poses[body]), "grasped", t)
+            for child in resting(body):
+                if child in objects and child not in self.held:
+                    held = Held(fingers, self._in(tool, child), self.poses[child], on=body)
+                    self._hold(child, held, "carried", t)
+
+    def _in(self, tool: Pose, body: str) -> Pose:
+        return compose(inverse(tool), self.poses[body])
+
+    def _hold(self, body: str, held: Held, why: str, t: float) -> None:
+        self.held[body] = held
+        self._note(body, why, self.entry(body), t, "")
 
     def update(self, tool: Pose, touching: Touching, t: float) -> None:
         """Move every held object with the tool (at ``tool``), and release those its fingers
-        no longer touch: they stay where the hand left them."""
-        for body, held in list(self.held.items()):
+        no longer touch, and what rests on them: they stay where the hand left them."""
+        for body, held in self.held.items():
             self.poses[body] = compose(tool, held.relative)
-            if touching(body, held.fingers) == 0:
-                del self.held[body]
-                before = {"pos": held.grasped[0], "rpy": list(matrix_rpy(held.grasped[1]))}
-                if body in self.sizes:
-                    before["size"] = self.sizes[body].copy()
-                self._note(body, "released", before, t, "")
+        let_go = [b for b, h in self.held.items() if not h.on and touching(b, h.fingers) == 0]
+        let_go += [b for b, h in self.held.items() if h.on and (h.on in let_go)]
+        for body in let_go:
+            held = self.held.pop(body)
+            before = {"pos": held.grasped[0], "rpy": list(matrix_rpy(held.grasped[1]))}
+            if body in self.sizes:
+                before["size"] = self.sizes[body].copy()
+            self._note(body, "released", before, t, "")
 
     # -- touch -------------------------------------------------------------------------------
     def locate(self, bodies: tuple[str, ...], shift: FloatArray, t: float, name: str) -> None:

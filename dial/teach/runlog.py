@@ -9,9 +9,8 @@ believed what its world file says throughout; its true poses are then those at t
 
 from __future__ import annotations
 
-import json
 import math
-from collections.abc import Iterator, Mapping
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
@@ -19,8 +18,8 @@ import mujoco
 import numpy as np
 
 from dial.backend.model import load_model
-from dial.errors import DialError
 from dial.geometry import matrix_rpy
+from dial.recording.timeline import read_log
 from dial.scene.belief import initial
 from dial.scene.resolve import worlds_dir
 from dial.scene.world import World, load_world
@@ -28,16 +27,10 @@ from dial.teach.describe import columns
 from dial.teach.frames import deg_text, mm_text
 
 
-class LogFileError(DialError):
-    """The log cannot be read, or is not a ``dial run`` log."""
-
-
 def believed_from_log(path: Path) -> str:
     """The text ``dial world --believed`` prints for the log at ``path``."""
-    records = list(_records(path))
-    scene = next((r for r in records if r.get("kind") == "scene"), None)
-    if scene is None:
-        raise LogFileError(f"{path}: no 'scene' record: not the log of a dial run")
+    records = read_log(path)  # checked: a 'scene' record first, known records well typed
+    scene = records[0]
     world = load_world(_world_path(str(scene["world"])))
     shift = [float(v) for v in scene.get("perturb", [0.0, 0.0, 0.0])]
     lines = [
@@ -59,23 +52,6 @@ def believed_from_log(path: Path) -> str:
     lines += ["", "belief updates (pos mm; size: half-sizes mm)"]
     lines += columns([_update(r) for r in updates])
     return "\n".join(lines) + "\n"
-
-
-def _records(path: Path) -> Iterator[dict[str, Any]]:
-    try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as e:
-        why = getattr(e, "strerror", None) or e
-        raise LogFileError(f"cannot read the log '{path}': {why}") from None
-    for number, line in enumerate(text.splitlines(), start=1):
-        if not line.strip():
-            continue
-        try:
-            record = json.loads(line)
-        except json.JSONDecodeError:
-            raise LogFileError(f"{path}:{number}: not a JSON record") from None
-        if isinstance(record, dict):
-            yield record
 
 
 def _world_path(world: str) -> Path:
