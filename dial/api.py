@@ -129,7 +129,6 @@ def run(
     save_at: tuple[int, str | Path] | None = None,
     resume: str | Path | None = None,
     console: Console | None = None,
-    save_world: str | Path | None = None,
     follow_grasps: bool = True,
 ) -> RunResult:
     """Run a script in its scene, as ``dial run`` does, and return its :class:`RunResult`.
@@ -137,19 +136,15 @@ def run(
     ``script``: a :class:`Script` from :func:`load`, or a path or bundled name to load (with
     ``scene``). The keywords are ``dial run``'s options, each described in docs/api.md. A
     stop signal (SIGINT, SIGTERM) ends the run cleanly: ``result.summary.interrupted``.
-    ``follow_grasps=False`` keeps grasped objects where the world model believed them, as
-    before the world model followed the hand (for comparisons).
     """
     items, saved = _checked(tick, speed, seed, perturb, disturb, save_at, resume)
-    world_file = None if save_world is None else _world_file(save_world)
     _check_watching(record, video, rerun, viewer)  # before the script: usage comes first
     script = _script(script, scene)
-    from dial.engine import RunOptions
-    from dial.engine import run as run_engine
+    from dial import engine
 
     stops, console = _pausing(script, breaks, step, console)
     with _log_sink(log) as sink:
-        options = RunOptions(
+        options = engine.RunOptions(
             tick=tick,
             speed=speed,
             seed=seed,
@@ -167,23 +162,28 @@ def run(
             resume=saved,
             follow_grasps=follow_grasps,
         )
-        result = run_engine(script, options)
-    if world_file is not None:
-        from dial.teach.believed import save_world as write_believed
-
-        note = f"The believed world at the end of `dial run {Path(script.path).name}`."
-        write_believed(result.world, result.believed, world_file, note)
-    return result
+        return engine.run(script, options)
 
 
-def _world_file(path: str | Path) -> Path:
-    """``--save-world F.toml``: a usage error, before anything runs, if F cannot be written."""
+def world_file(path: str | Path) -> Path:
+    """``--save-world F.toml``'s check: a :class:`dial.OptionError` (the command line's usage
+    error) if F is not ``.toml`` or cannot be written, before anything runs."""
     if Path(path).suffix.lower() != ".toml":
         raise OptionError(f"--save-world writes a world file (.toml), not '{path}'")
     try:
         return writable(path, "the world file")
     except DialError as e:
         raise OptionError(f"--save-world: {e}") from None
+
+
+def save_world(result: RunResult, path: str | Path, made_by: str = "a run") -> None:
+    """Write what the world model believed at the end of ``result``'s run as a world file:
+    the run's own, its comments kept, each object's believed pose and size in ``[objects]``
+    (``dial run --save-world``; docs/teaching.md). ``made_by`` goes into its first line."""
+    from dial.teach.believed import save_world as write
+
+    note = f"The believed world at the end of {made_by}."
+    write(result.world, result.believed, world_file(path), note)
 
 
 def _checked(

@@ -6,6 +6,7 @@ import argparse
 import json
 import sys
 from collections.abc import Callable
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 from dial import api
@@ -133,6 +134,7 @@ def _run(args: argparse.Namespace, stop: StopRequest) -> int:
         raise UsageError("--log-states writes into the log: give --log FILE.jsonl too")
     api.check_options(args.tick, args.speed, args.seed, args.perturb)
     save_at = _save_at(args.save_at)
+    world_file = None if args.save_world is None else api.world_file(args.save_world)
     script = load_script(args.script, args.scene)
     if stop.signal is not None:  # while the script was being checked
         print(f"dial: interrupted by {stop.signal}", file=sys.stderr)
@@ -156,14 +158,10 @@ def _run(args: argparse.Namespace, stop: StopRequest) -> int:
         step=args.step,
         save_at=save_at,
         resume=args.resume,
-        save_world=args.save_world,
     )
-    for number, target in result.saved:
-        print(f"dial: saved the state before block {number} to {target}", file=sys.stderr)
-    if not args.quiet and sys.stderr.isatty():
-        sys.stderr.write("\r" + " " * 100 + "\r")
-    if not args.quiet:
-        sys.stdout.write(summary_text(result))
+    if world_file is not None:
+        api.save_world(result, world_file, f"`dial run {Path(script.path).name}`")
+    _print_summary(result, args.quiet)
     stopped = result.summary.interrupted
     if stopped is not None:
         print(f"dial: interrupted by {stopped}; every effector holds its pose", file=sys.stderr)
@@ -187,6 +185,16 @@ def _run(args: argparse.Namespace, stop: StopRequest) -> int:
         )
         return 1
     return 0 if result.ok else 1
+
+
+def _print_summary(result: RunResult, quiet: bool) -> None:
+    """The state files saved, then (unless quiet) the summary table."""
+    for number, target in result.saved:
+        print(f"dial: saved the state before block {number} to {target}", file=sys.stderr)
+    if not quiet and sys.stderr.isatty():
+        sys.stderr.write("\r" + " " * 100 + "\r")
+    if not quiet:
+        sys.stdout.write(summary_text(result))
 
 
 def _save_at(value: list[str] | None) -> tuple[int, str] | None:

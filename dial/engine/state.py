@@ -183,19 +183,7 @@ def save(
         "contacts": ctx.point_sets,
         "stops": {str(f): [_point(c.tactile), _point(c.link)] for f, c in ctx.stops.items()},
         "results": ctx.results,
-        "believed": {body: _array(pos) for body, (pos, _) in ctx.believed.items()},
-        "believed_rot": {body: _array(rot) for body, (_, rot) in ctx.believed.items()},
-        "sizes": {body: _array(size) for body, size in ctx.world_model.sizes.items()},
-        "learned": ctx.world_model.changed,
-        "held": {
-            body: {
-                "fingers": list(held.fingers),
-                "relative": [_array(held.relative[0]), _array(held.relative[1])],
-                "grasped": [_array(held.grasped[0]), _array(held.grasped[1])],
-                "on": held.on,
-            }
-            for body, held in ctx.world_model.held.items()
-        },
+        **_beliefs(ctx),
         "robot": {
             "steps": robot.steps,
             "arm_target": _array(robot.arm_target),
@@ -313,6 +301,26 @@ class Saved:
             ctx.stops[int(f)] = StopContact(_stop_point(tactile), _stop_point(link))
         ctx.results.update(d["results"])
         _restore_beliefs(d, ctx)
+
+
+def _beliefs(ctx: Context) -> dict[str, Any]:
+    """The world model's part of a state file: believed poses and sizes, what is held."""
+    held = {
+        body: {
+            "fingers": list(h.fingers),
+            "relative": [_array(h.relative[0]), _array(h.relative[1])],
+            "grasped": [_array(h.grasped[0]), _array(h.grasped[1])],
+            "on": h.on,
+        }
+        for body, h in ctx.world_model.held.items()
+    }
+    return {
+        "believed": {body: _array(pos) for body, (pos, _) in ctx.believed.items()},
+        "believed_rot": {body: _array(rot) for body, (_, rot) in ctx.believed.items()},
+        "sizes": {body: _array(size) for body, size in ctx.world_model.sizes.items()},
+        "learned": ctx.world_model.changed,
+        "held": held,
+    }
 
 
 def _restore_beliefs(d: dict[str, Any], ctx: Context) -> None:

@@ -149,11 +149,7 @@ def describe(record: Record) -> tuple[str, str] | None:
     if kind == "thread":
         return f"thread {record['name']} released", "info"
     if kind == "belief":
-        before, after = record["before"].get("pos"), record["after"].get("pos")
-        moved = ""
-        if isinstance(before, list) and isinstance(after, list) and len(before) == len(after):
-            moved = f", moved {1000.0 * math.dist(before, after):.1f} mm"
-        return f"world model: {record['object']} {record['why']}{moved}", "info"
+        return _belief(record), "info"
     if kind == "monitor":
         return f"monitor '@on {record['condition']}' (line {record['line']}) fired", "warn"
     if kind == "disturb":
@@ -174,6 +170,15 @@ def describe(record: Record) -> tuple[str, str] | None:
         verdict = "OK" if record.get("ok") else "FAILED"
         return f"{verdict} {marks}".rstrip(), "info" if record.get("ok") else "error"
     return None
+
+
+def _belief(record: Record) -> str:
+    """A ``belief`` record: which object the world model changed, why, and how far it moved."""
+    before, after = record["before"].get("pos"), record["after"].get("pos")
+    moved = ""
+    if isinstance(before, list) and isinstance(after, list) and len(before) == len(after):
+        moved = f", moved {1000.0 * math.dist(before, after):.1f} mm"
+    return f"world model: {record['object']} {record['why']}{moved}"
 
 
 def timeline(records: Iterable[Record]) -> str:
