@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import importlib.util
 import json
 import os
 from pathlib import Path
@@ -15,6 +16,20 @@ if TYPE_CHECKING:
 ROOT = Path(__file__).resolve().parent.parent
 DATA = ROOT / "tests" / "data"
 UPDATE = os.environ.get("DIAL_UPDATE_GOLDEN") == "1"
+
+
+def needs(extra: str, *modules: str) -> pytest.MarkDecorator:
+    """Skip a test, saying why, when an optional extra it needs is not installed."""
+    missing = [m for m in modules if importlib.util.find_spec(m) is None]
+    reason = (
+        f"the '{extra}' extra is not installed ({', '.join(missing)}): pip install -e '.[{extra}]'"
+    )
+    return pytest.mark.skipif(bool(missing), reason=reason)
+
+
+NEEDS_PLOT = needs("plot", "matplotlib")
+NEEDS_VIDEO = needs("video", "imageio", "imageio_ffmpeg")
+NEEDS_RAY = needs("ray", "ray")
 
 
 def golden(path: Path, actual: str) -> None:

@@ -7,15 +7,14 @@ one: a straight-line move solves one waypoint per control period.
 
 from __future__ import annotations
 
-from collections import OrderedDict
-
 import mink
 import mujoco
 import numpy as np
 
 from dial.backend.model import RobotIndex, load_model
-from dial.backend.snapshot import FloatArray
 from dial.errors import DialError
+from dial.robot.memo import SOLUTIONS, memo_key
+from dial.robot.snapshot import FloatArray
 
 SOLVER = "daqp"
 DT = 0.01  # s: the differential step of one solve
@@ -27,64 +26,6 @@ DAMPING = 1e-3  # mink's Levenberg-Marquardt damping of every step
 
 class IKError(DialError):
     """A target the arm or a finger cannot reach; the message says how far off it stays."""
-
-
-class _Memo:
-    """Solutions already found in this process, by their exact inputs.
-
-    A solve depends only on its inputs (the solvers keep no state between calls that
-    changes a result), so a repeated problem gives back the very same array: the runs of a
-    script in one process (a sweep's trials, a notebook, a benchmark) solve the same
-    targets, since locations follow the *believed* object poses. Bounded, oldest first out.
-    """
-
-    SIZE = 50_000
-
-    def __init__(self) -> None:
-        self._values: OrderedDict[tuple[object, ...], object] = OrderedDict()
-
-    @staticmethod
-    def key(kind: str, *parts: object) -> tuple[object, ...]:
-        return (
-            kind,
-            *(
-                np.ascontiguousarray(p, dtype=np.float64).tobytes()
-                if isinstance(p, np.ndarray)
-                else p
-                for p in parts
-            ),
-        )
-
-    def get(self, key: tuple[object, ...]) -> object:
-        return self._values.get(key)
-
-    def clear(self) -> None:
-        self._values.clear()
-
-    def put(self, key: tuple[object, ...], value: object) -> None:
-        self._values[key] = value
-        if len(self._values) > self.SIZE:
-            self._values.popitem(last=False)
-
-
-_MEMO = _Memo()
-
-
-def recall(kind: str, *parts: object) -> tuple[tuple[object, ...], object]:
-    """The memo's key for a result computed from these exact inputs, and the result if one
-    is known (else None): for results built from solves, such as a line's waypoints."""
-    key = _Memo.key(kind, *parts)
-    return key, _MEMO.get(key)
-
-
-def remember(key: tuple[object, ...], value: object) -> None:
-    """Keep ``value`` under ``key`` (from :func:`recall`)."""
-    _MEMO.put(key, value)
-
-
-def forget_solutions() -> None:
-    """Empty the memo: the next solves cost what they cost in a fresh process (benchmarks)."""
-    _MEMO.clear()
 
 
 class _Base:
@@ -147,14 +88,14 @@ class ArmIK(_Base):
         self, pos: FloatArray, rot: FloatArray, arm_q: FloatArray, iterations: int = 2
     ) -> FloatArray:
         """A few warm-started steps from ``arm_q`` toward the pose: one waypoint of a line."""
-        key = _Memo.key(f"{self.MEMO}-track", pos, rot, arm_q, iterations)
-        known = _MEMO.get(key)
+        key = memo_key(f"{self.MEMO}-track", pos, rot, arm_q, iterations)
+        known = SOLUTIONS.get(key)
         if isinstance(known, np.ndarray):
             return known.copy()
         self._set(arm_q)
         self._iterate(pos, rot, iterations)
         q: FloatArray = self.config.q[self.index.arm_qpos].copy()
-        _MEMO.put(key, q.copy())
+        SOLUTIONS.put(key, q.copy())
         return q
 
     def solve(self, pos: FloatArray, rot: FloatArray, arm_q: FloatArray, what: str) -> FloatArray:
@@ -166,8 +107,8 @@ class ArmIK(_Base):
         converges wins. Deterministic.
         """
         start = np.asarray(arm_q, dtype=np.float64)
-        key = _Memo.key(f"{self.MEMO}-solve", pos, rot, start)
-        known = _MEMO.get(key)
+        key = memo_key(f"{self.MEMO}-solve", pos, rot, start)
+        known = SOLUTIONS.get(key)
         closest = known if isinstance(known, tuple) else (np.inf, np.inf)
         if isinstance(known, np.ndarray):
             return known.copy()
@@ -176,10 +117,10 @@ class ArmIK(_Base):
             perr, rerr = self._iterate(pos, rot, SOLVE_ITERATIONS)
             if perr <= 2e-3 and rerr <= 1e-2:
                 q: FloatArray = self.config.q[self.index.arm_qpos].copy()
-                _MEMO.put(key, q.copy())
+                SOLUTIONS.put(key, q.copy())
                 return q
             closest = min(closest, (perr, rerr))
-        _MEMO.put(key, closest)
+        SOLUTIONS.put(key, closest)
         raise IKError(
             f"{what} is out of the arm's reach: the tool stays {closest[0] * 1000:.1f} mm "
             f"and {np.degrees(closest[1]):.1f} deg away"
@@ -237,8 +178,8 @@ class FingerIK(_Base):
         iterations: int = 2,
     ) -> FloatArray:
         """Steps from ``hand_q`` moving the fingertip toward ``tip`` (world, m); returns (16,)."""
-        key = _Memo.key("finger-track", finger, tip, arm_q, hand_q, iterations)
-        known = _MEMO.get(key)
+        key = memo_key("finger-track", finger, tip, arm_q, hand_q, iterations)
+        known = SOLUTIONS.get(key)
         if isinstance(known, np.ndarray):
             return known.copy()
         self._set(arm_q, hand_q)
@@ -264,5 +205,5 @@ class FingerIK(_Base):
             )
             self.config.integrate_inplace(vel, DT)
         q: FloatArray = self.config.q[self.index.hand_qpos].copy()
-        _MEMO.put(key, q.copy())
+        SOLUTIONS.put(key, q.copy())
         return q

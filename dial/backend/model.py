@@ -13,6 +13,7 @@ import copy
 import os
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import mujoco
 import numpy as np
@@ -20,6 +21,10 @@ from numpy.typing import ArrayLike, NDArray
 
 from dial.errors import DialError
 from dial.resources import data_dir
+from dial.robot.view import FingerView, RobotView
+
+if TYPE_CHECKING:
+    from dial.scene.world import World
 
 ROBOT_DIR = data_dir("models") / "utah_hand_puma"
 ROBOT_XML = ROBOT_DIR / "utah_hand_puma.xml"
@@ -198,6 +203,47 @@ class RobotIndex:
             moment_arm=float(np.abs(model.wrap_prm[model.tendon_adr[tendon_ids]]).max()),
             tension_limit=float(model.actuator_forcerange[tendons, 1].max()),
         )
+
+
+def scene_bodies(model: mujoco.MjModel, world: World) -> list[int]:
+    """Bodies a perturbation moves: every free body, and the world file's fixed objects."""
+    named = {
+        int(mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, b)) for b in world.objects.values()
+    }
+    free = {
+        int(model.jnt_bodyid[j])
+        for j in range(model.njnt)
+        if model.jnt_type[j] == mujoco.mjtJoint.mjJNT_FREE
+    }
+    return sorted(named | free)
+
+
+def robot_view(model: mujoco.MjModel, index: RobotIndex) -> RobotView:
+    """The read-only view of the Utah/MIT hand on the PUMA in ``model`` (its ranges as the
+    model has them)."""
+    fingers = []
+    for f, name in enumerate(FINGERS):
+        prefix = f"hand_{name}_"
+        bodies = tuple(
+            n for n in (model.body(b).name for b in range(model.nbody)) if n.startswith(prefix)
+        )
+        joints = HAND_JOINTS[4 * f : 4 * f + 4]
+        fingers.append(FingerView(name, joints, f"{prefix}tip", f"{prefix}tactile", bodies))
+    hand = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, n) for n in HAND_JOINTS]
+    hand_range = model.jnt_range[hand].copy()
+    arm_range = model.jnt_range[model.actuator_trnid[index.arm_actuators, 0]].copy()
+    for array in (hand_range, arm_range):
+        array.flags.writeable = False
+    return RobotView(
+        "utah_hand_puma",
+        ARM_JOINTS,
+        arm_range,
+        "hand_palm",
+        tuple(fingers),
+        hand_range,
+        "tendon",
+        TAXEL_SHAPE,
+    )
 
 
 def hand_ctrl(q_desired: ArrayLike) -> FloatArray:

@@ -5,16 +5,25 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 from dial import api
-from dial.cli.common import UsageError, load_script, scene_argument
+from dial.cli.common import (
+    UsageError,
+    dataset_arguments,
+    dataset_request,
+    load_script,
+    scene_argument,
+)
+from dial.cli.remote import add_run_options, check_remote
 from dial.recording.timeline import qualified_event
 from dial.scheduler.signals import EXIT_STATUS, StopRequest, catch_stop_signals
 
 if TYPE_CHECKING:
+    from dial.dataset.writer import DatasetWriter
     from dial.engine import RunResult
 
 DESCRIPTION = (
@@ -118,29 +127,46 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         help="go on from a state file (with its tick, seed, perturbation and disturbances); "
         "lines of the script before the saved block must be unchanged",
     )
+    dataset_arguments(p, sweep=False)
+    add_run_options(p)
     p.set_defaults(func=cmd_run)
 
 
 def cmd_run(args: argparse.Namespace) -> int:
-    # From here to the exit, a stop signal stops the run (which catches it first) or, once
-    # the run is over, is ignored: a second Ctrl-C cannot cut the summary or the log short.
-    stop = StopRequest()
-    with catch_stop_signals(stop):
-        return _run(args, stop)
+    # The command owns the stop signals from here to the exit: one stops the run (dial.run
+    # checks the options, then the script, then runs it) or, once the run is over, is
+    # ignored: a second Ctrl-C cannot cut the summary or the log short.
+    check_remote(args)
+    with catch_stop_signals() as stop:
+        if args.remote is not None:
+            return _remote(args, stop)
+        return _run(args)
 
 
-def _run(args: argparse.Namespace, stop: StopRequest) -> int:
+def _run(args: argparse.Namespace) -> int:
     if args.log_states and not args.log:
         raise UsageError("--log-states writes into the log: give --log FILE.jsonl too")
-    api.check_options(args.tick, args.speed, args.seed, args.perturb)
     save_at = _save_at(args.save_at)
     world_file = None if args.save_world is None else api.world_file(args.save_world)
-    script = load_script(args.script, args.scene)
-    if stop.signal is not None:  # while the script was being checked
-        print(f"dial: interrupted by {stop.signal}", file=sys.stderr)
-        return EXIT_STATUS[stop.signal]
-    result = api.run(
-        script,
+    folder, fps, cameras = dataset_request(args)
+    with _dataset(folder, fps) as writer:
+        result = _run_api(args, save_at, writer, cameras)
+    if writer is not None and folder is not None:
+        _said_written(writer, folder)
+    if world_file is not None:
+        api.save_world(result, world_file, f"`dial run {Path(args.script).name}`")
+    return _report(args, result, save_at)
+
+
+def _run_api(
+    args: argparse.Namespace,
+    save_at: tuple[int, str] | None,
+    writer: DatasetWriter | None,
+    cameras: list[str],
+) -> RunResult:
+    return api.run(
+        args.script,
+        scene=args.scene,
         tick=args.tick,
         speed=args.speed,
         seed=args.seed,
@@ -158,10 +184,41 @@ def _run(args: argparse.Namespace, stop: StopRequest) -> int:
         step=args.step,
         save_at=save_at,
         resume=args.resume,
+        dataset=writer,
+        cameras=cameras,
     )
-    if world_file is not None:
-        api.save_world(result, world_file, f"`dial run {Path(script.path).name}`")
-    _print_summary(result, args.quiet)
+
+
+@contextmanager
+def _dataset(folder: str | None, fps: int | None) -> Iterator[DatasetWriter | None]:
+    """``--dataset DIR``'s writer, open for the run (closing it commits the episode)."""
+    if folder is None:
+        yield None
+        return
+    from dial.dataset.writer import DatasetWriter
+
+    with DatasetWriter(folder, fps=50 if fps is None else fps) as writer:
+        yield writer
+
+
+def _said_written(writer: DatasetWriter, folder: str) -> None:
+    if writer.added:
+        print(
+            f"dial: episode {writer.episodes - 1} ({writer.last_frames} frames) written to "
+            f"{folder}; it holds {writer.episodes} episodes",
+            file=sys.stderr,
+        )
+    else:
+        print(f"dial: no episode written to {folder} (the run did not finish)", file=sys.stderr)
+
+
+def _report(args: argparse.Namespace, result: RunResult, save_at: tuple[int, str] | None) -> int:
+    for number, target in result.saved:
+        print(f"dial: saved the state before block {number} to {target}", file=sys.stderr)
+    if not args.quiet and sys.stderr.isatty():
+        sys.stderr.write("\r" + " " * 100 + "\r")
+    if not args.quiet:
+        sys.stdout.write(summary_text(result))
     stopped = result.summary.interrupted
     if stopped is not None:
         print(f"dial: interrupted by {stopped}; every effector holds its pose", file=sys.stderr)
@@ -187,14 +244,16 @@ def _run(args: argparse.Namespace, stop: StopRequest) -> int:
     return 0 if result.ok else 1
 
 
-def _print_summary(result: RunResult, quiet: bool) -> None:
-    """The state files saved, then (unless quiet) the summary table."""
-    for number, target in result.saved:
-        print(f"dial: saved the state before block {number} to {target}", file=sys.stderr)
-    if not quiet and sys.stderr.isatty():
-        sys.stderr.write("\r" + " " * 100 + "\r")
-    if not quiet:
-        sys.stdout.write(summary_text(result))
+def _remote(args: argparse.Namespace, stop: StopRequest) -> int:
+    """``dial run --remote``: the options and the script checked here, then the robot's run."""
+    from dial.cli.run_remote import run_remote
+
+    api.check_options(args.tick, args.speed, args.seed, args.perturb)
+    script = load_script(args.script, args.scene)
+    if stop.signal is not None:  # while the script was being checked
+        print(f"dial: interrupted by {stop.signal}", file=sys.stderr)
+        return EXIT_STATUS[stop.signal]
+    return run_remote(args, script, stop, _progress(args.quiet), summary_text)
 
 
 def _save_at(value: list[str] | None) -> tuple[int, str] | None:

@@ -4,17 +4,23 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from dial import api
 from dial.cli.common import (
     UsageError,
     at_least,
+    dataset_arguments,
+    dataset_request,
     load_script,
     scene_argument,
     sigterm_as_interrupt,
 )
 from dial.disturb import parse_disturbance
 from dial.instructions.scene_names import SceneNotFoundError
+
+if TYPE_CHECKING:
+    from dial.dataset.plan import Request
 
 
 def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
@@ -74,7 +80,15 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
     )
     p.add_argument("--plot", metavar="FILE.png", help="plot success rate and task time")
     p.add_argument("--json", action="store_true", help="print the table as JSON, last line")
+    dataset_arguments(p, sweep=True)
     p.set_defaults(func=cmd_tune)
+
+
+def _own_tick(script: str, scene: str | None) -> tuple[float]:
+    """Without ``--ticks``, the script's own tick (checked here, as the sweep would)."""
+    from dial.engine.run import DEFAULT_TICK
+
+    return (load_script(script, scene).tick or DEFAULT_TICK,)
 
 
 def cmd_tune(args: argparse.Namespace) -> int:
@@ -82,7 +96,7 @@ def cmd_tune(args: argparse.Namespace) -> int:
     from dial.tune import ProcessExecutor, TuneOptions, models, parse_ticks, tune
 
     try:
-        ticks = parse_ticks(args.ticks) if args.ticks is not None else None
+        ticks = parse_ticks(args.ticks) if args.ticks is not None else ()
     except ValueError as e:
         raise UsageError(f"--ticks: {e}") from None
     at_least("--trials", args.trials, 1)
@@ -98,20 +112,19 @@ def cmd_tune(args: argparse.Namespace) -> int:
         scene = None if args.scene is None else scene_option(args.scene)
     except SceneNotFoundError as e:
         raise UsageError(str(e)) from None
-    if ticks is None:  # the script's own tick: it is checked here, as the sweep would
-        from dial.engine.run import DEFAULT_TICK
-
-        ticks = (load_script(args.script, scene).tick or DEFAULT_TICK,)
+    dataset, request = _dataset(args)
     options = TuneOptions(
         script=args.script,
         scene=scene,
-        ticks=ticks,
+        ticks=ticks or _own_tick(args.script, scene),
         trials=args.trials,
         perturb_mm=args.perturb,
         seed=args.seed,
         plot=Path(args.plot) if args.plot else None,
         json=args.json,
         disturb=tuple(args.disturb),
+        dataset=dataset,
+        request=request,
     )
     # Each worker compiles a model file once and gives each trial a copy (dial.tune.models).
     if args.executor == "process":
@@ -128,3 +141,15 @@ def cmd_tune(args: argparse.Namespace) -> int:
         raise UsageError(str(e)) from None
     with sigterm_as_interrupt():
         return tune(options, executor)
+
+
+def _dataset(args: argparse.Namespace) -> tuple[Path | None, Request | None]:
+    """``--dataset`` and its options, checked before any trial runs."""
+    folder, fps, cameras = dataset_request(args)
+    if folder is None:
+        return None, None
+    from dial.dataset.plan import Request, check_request
+
+    request = Request(50 if fps is None else fps, tuple(cameras), args.successful_only)
+    check_request(request)
+    return Path(folder), request

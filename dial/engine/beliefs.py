@@ -15,8 +15,9 @@ from typing import Any
 
 import numpy as np
 
+from dial.backend.driver import MujocoRobot
 from dial.geometry import matrix_rpy
-from dial.primitives import Context
+from dial.primitives.context import Context
 from dial.scheduler.log import EventLog
 from dial.scheduler.runner import Runner
 
@@ -31,13 +32,13 @@ def journal(log: EventLog, runner: Runner[Any]) -> Callable[[dict[str, object]],
     return write
 
 
-def believed_world(log: EventLog, ctx: Context, ticks: int) -> None:
+def believed_world(log: EventLog, ctx: Context, robot: MujocoRobot, ticks: int) -> None:
     """The ``world`` record at the end of a run whose world model changed."""
     model = ctx.world_model
-    ctx.refresh(ctx.robot.time)  # a held object where the tool is now
+    ctx.refresh()  # a held object where the tool is now
     if not model.changed:
         return
-    m, d = ctx.robot.model, ctx.robot.data
+    m, d = robot.model, robot.data
     objects: dict[str, object] = {}
     for alias, body in ctx.world.objects.items():
         b = m.body(body).id
@@ -46,4 +47,4 @@ def believed_world(log: EventLog, ctx: Context, ticks: int) -> None:
         believed["held"] = body in model.held
         off = float(np.linalg.norm(np.asarray(believed["pos"]) - d.xpos[b]))
         objects[alias] = {"body": body, "believed": believed, "true": true, "off": off}
-    log.write("world", tick=ticks, t=ctx.robot.time, objects=objects)
+    log.write("world", tick=ticks, t=robot.time, objects=objects)

@@ -10,7 +10,7 @@ import mujoco
 from dial.scene.evaluate import measure
 from dial.scene.world import World
 from dial.scheduler.log import EventLog, Record
-from dial.scheduler.runner import RunSummary
+from dial.scheduler.runner import Tally
 
 
 @dataclass(frozen=True)
@@ -47,7 +47,7 @@ class RunResult:
     what the world model believes of each object at the end (``dial run --save-world``).
     """
 
-    summary: RunSummary
+    summary: Tally
     world: World
     criteria: Criteria
     results: dict[str, dict[str, object]]

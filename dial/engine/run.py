@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TextIO
@@ -17,24 +17,24 @@ from typing import TextIO
 import trio
 
 from dial.backend.driver import MujocoRobot
-from dial.backend.snapshot import Snapshot
 from dial.debug import Break, Console, Session
-from dial.disturb import Disturbance, parse_disturbance
+from dial.disturb import Disturbance
 from dial.engine.beliefs import believed_world, journal
 from dial.engine.debugging import session
 from dial.engine.observe import Observer, StateLog, Watched, describe, fan_out, first_line
 from dial.engine.result import RunResult, measure_criteria
-from dial.engine.setup import prepare
-from dial.engine.state import RunSettings, Saved
+from dial.engine.setup import Factory, prepare
+from dial.engine.state import RunSettings, StateFile
 from dial.errors import DialError, OptionError
 from dial.parser.lanes import LanePlan
 from dial.parser.script import Script
-from dial.primitives import Context, make_factory
+from dial.primitives.context import Context
+from dial.robot.snapshot import Snapshot
 from dial.scheduler.log import EventLog
 from dial.scheduler.position import Resume
-from dial.scheduler.runner import Runner
+from dial.scheduler.runner import Runner, Tally
 from dial.scheduler.signals import StopRequest, catch_stop_signals
-from dial.scheduler.ticks import Progress
+from dial.scheduler.ticks import Progress, TickLoop
 
 DEFAULT_TICK = 0.25  # s, when neither the script (@tick) nor the command line sets one
 MAX_TICK = 60.0  # s, as @tick's range
@@ -50,6 +50,7 @@ class RunOptions:
     perturb_mm: float = 0.0
     disturb: Sequence[Disturbance] = ()
     realtime: bool = False
+    pace: float | None = None  # wall s per simulated s (--realtime is 1); None: unpaced
     log: TextIO | None = None  # the JSON Lines sink, written and flushed record by record
     log_states: bool = False
     progress: Progress | None = None
@@ -59,22 +60,24 @@ class RunOptions:
     step: bool = False
     console: Console | None = None
     save_at: tuple[int, Path] | None = None  # (block number, state file)
-    resume: Saved | None = None  # a state file to go on from (its settings win)
+    resume: StateFile | None = None  # a state file to go on from (its settings win)
+    stop: StopRequest | None = None  # polled every period (a remote session's); else signals'
     follow_grasps: bool = True  # grasped objects follow the hand in the world model
 
 
 def tick_length(script: Script, options: RunOptions) -> float:
-    """The tick the run uses, in s: ``--tick``, else ``@tick``, else the default; / speed."""
+    """The tick the run uses, in s: ``--tick``, else ``@tick``, else the default; / speed.
+
+    The options alone are checked once, by :func:`dial.api.run`; here only what depends on
+    the script too: ``@tick`` divided by ``--speed`` may leave the range."""
     tick = options.tick if options.tick is not None else (script.tick or DEFAULT_TICK)
-    if not (math.isfinite(options.speed) and options.speed > 0):
-        raise OptionError(f"--speed must be a positive number, got {options.speed:g}")
-    if not (math.isfinite(tick) and 0 < tick / options.speed <= MAX_TICK):
+    length = tick / options.speed if options.speed > 0 else math.inf
+    if not (math.isfinite(length) and 0 < length <= MAX_TICK):
         by = f" (--speed {options.speed:g})" if options.speed != 1.0 else ""
         raise OptionError(
-            f"the tick must be above 0 s and at most {MAX_TICK:g} s, got "
-            f"{tick / options.speed:g} s{by}"
+            f"the tick must be above 0 s and at most {MAX_TICK:g} s, got {length:g} s{by}"
         )
-    return tick / options.speed
+    return length
 
 
 def run(script: Script, options: RunOptions) -> RunResult:
@@ -83,13 +86,12 @@ def run(script: Script, options: RunOptions) -> RunResult:
     SIGINT and SIGTERM stop the run at the next control period, from the scene's loading on:
     every effector holds, and the log ends with ``interrupted`` and ``summary``.
     """
-    stop = StopRequest()
-    with catch_stop_signals(stop):
+    with catch_stop_signals() as signals:
+        stop = options.stop if options.stop is not None else signals
         log = EventLog(options.log)
         settings = _settings(script, options)
-        disturb = [parse_disturbance(d) for d in settings.disturb]
         robot, ctx = prepare(
-            script, log, settings.perturb_mm, settings.seed, disturb, options.follow_grasps
+            script, log, settings.perturb_mm, settings.seed, settings.disturb, options.follow_grasps
         )
         resume = _resume(script, options.resume, robot, ctx, log)
         states = [StateLog(lanes=LanePlan.from_script(script))] if options.log_states else []
@@ -99,45 +101,63 @@ def run(script: Script, options: RunOptions) -> RunResult:
             for observer in states + list(options.observers):
                 observer.begin(Watched(robot, ctx.world, log))
                 begun.append(observer)
+            runner: Runner[Snapshot]
+
+            def loop_of() -> TickLoop[Snapshot] | None:  # called once the run has started
+                return runner.loop
+
+            hooks = _debugging(script, loop_of, robot, ctx, stop, settings, begun, options)
             runner = Runner(
                 robot,
-                make_factory(ctx),
+                Factory(ctx),
                 settings.tick,
                 log,
                 progress=options.progress,
                 observe=fan_out(begun),
-                pace=1.0 if options.realtime else None,
+                pace=1.0 if options.realtime else options.pace,
                 stop=stop,
+                hooks=hooks,
             )
-            hooks = runner.hooks = _debugging(script, runner, ctx, stop, settings, begun, options)
             ctx.world_model.journal = journal(log, runner)
             start, cpu = time.perf_counter(), time.process_time()
             summary = trio.run(runner.run, script, resume)
             wall, cpu = time.perf_counter() - start, time.process_time() - cpu
-            believed_world(log, ctx, summary.ticks)
-            result = RunResult(
-                summary,
-                ctx.world,
-                measure_criteria(ctx.world, robot.model, robot.data, ctx.results),
-                dict(ctx.results),
-                wall,
-                cpu,
-                robot.steps,
-                log,
-                [float(x) for x in robot.data.qpos],
-                settings.disturb,
-                tuple(hooks.saved) if hooks is not None else (),
-                hooks.unsaved if hooks is not None else None,
-                {body: ctx.world_model.entry(body) for body in ctx.world.objects.values()},
-            )
+            result = _result(summary, robot, ctx, log, settings, hooks, (wall, cpu))
             log.write("summary", **result.as_record())
             return result
         finally:
             _end(begun, result)
 
 
+def _result(
+    summary: Tally,
+    robot: MujocoRobot,
+    ctx: Context,
+    log: EventLog,
+    settings: RunSettings,
+    hooks: Session | None,
+    times: tuple[float, float],
+) -> RunResult:
+    """The run's result, after the world model's closing ``world`` record."""
+    believed_world(log, ctx, robot, summary.ticks)
+    return RunResult(
+        summary,
+        ctx.world,
+        measure_criteria(ctx.world, robot.model, robot.data, ctx.results),
+        dict(ctx.results),
+        *times,
+        robot.steps,
+        log,
+        [float(x) for x in robot.data.qpos],
+        tuple(d.text for d in settings.disturb),
+        tuple(hooks.saved) if hooks is not None else (),
+        hooks.unsaved if hooks is not None else None,
+        {body: ctx.world_model.entry(body) for body in ctx.world.objects.values()},
+    )
+
+
 def _resume(
-    script: Script, saved: Saved | None, robot: MujocoRobot, ctx: Context, log: EventLog
+    script: Script, saved: StateFile | None, robot: MujocoRobot, ctx: Context, log: EventLog
 ) -> Resume | None:
     """Put a saved state back (checking the script against it) and log the ``resume``."""
     if saved is None:
@@ -162,13 +182,14 @@ def _settings(script: Script, options: RunOptions) -> RunSettings:
         tick_length(script, options),
         options.seed,
         options.perturb_mm,
-        tuple(d.text for d in options.disturb),
+        tuple(options.disturb),
     )
 
 
 def _debugging(
     script: Script,
-    runner: Runner[Snapshot],
+    loop_of: Callable[[], TickLoop[Snapshot] | None],
+    robot: MujocoRobot,
     ctx: Context,
     stop: StopRequest,
     settings: RunSettings,
@@ -180,7 +201,8 @@ def _debugging(
         return None
     return session(
         script,
-        runner,
+        loop_of,
+        robot,
         ctx,
         stop,
         settings,

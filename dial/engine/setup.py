@@ -13,36 +13,27 @@ import numpy as np
 
 from dial.backend.disturb import Disturbances
 from dial.backend.driver import MujocoRobot
-from dial.backend.ik import ArmIK
-from dial.backend.model import ARM_HOME, RobotIndex, hand_ctrl, load_model
+from dial.backend.ik import ArmIK, FingerIK
+from dial.backend.locate import fingers_touching, resting_on
+from dial.backend.model import ARM_HOME, RobotIndex, hand_ctrl, load_model, scene_bodies
 from dial.disturb import Disturbance
 from dial.geometry import Pose, location_pose, rpy_matrix
 from dial.parser.script import Script
-from dial.primitives import Context
-from dial.scene.belief import Beliefs, initial
+from dial.primitives.context import Context
+from dial.robot.snapshot import Snapshot
+from dial.scene.belief import Beliefs, Feeling, initial
 from dial.scene.of_script import script_world
 from dial.scene.resolve import worlds_dir
 from dial.scene.thread import set_turns
 from dial.scene.world import World
 from dial.scheduler.log import EventLog
+from dial.scheduler.primitive import Primitive, Sensor
+from dial.scheduler.types import RunInfo
 
 SETTLE_S = 0.5  # objects settle on the table before the script starts
 # Where the tool starts when the world file has no "home" location: high above the tables,
 # pointing down (world m; rpy as in world files).
 START = ((0.40, 0.0, 0.80), (np.pi, 0.0, 0.0))
-
-
-def scene_bodies(model: mujoco.MjModel, world: World) -> list[int]:
-    """Bodies a perturbation moves: every free body, and the world file's fixed objects."""
-    named = {
-        int(mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, b)) for b in world.objects.values()
-    }
-    free = {
-        int(model.jnt_bodyid[j])
-        for j in range(model.njnt)
-        if model.jnt_type[j] == mujoco.mjtJoint.mjJNT_FREE
-    }
-    return sorted(named | free)
 
 
 def perturb(model: mujoco.MjModel, world: World, mm: float, seed: int) -> list[float]:
@@ -108,5 +99,34 @@ def prepare(
     where = world.path.name if bundled else str(world.path)
     log.write("scene", scene=world.name, world=where, perturb=shift, seed=seed)
     robot = MujocoRobot(model, data, disturbances=placed)
-    beliefs = Beliefs(world, believed, sizes, follow=follow)
-    return robot, Context(robot, world, believed, ik, beliefs=beliefs)
+    beliefs = Beliefs(world, believed, sizes, follow=follow, feeling=feeling(robot))
+    return robot, Context(robot, robot.view, world, believed, ik, FingerIK(), beliefs=beliefs)
+
+
+def feeling(robot: MujocoRobot) -> Feeling:
+    """What the world model asks of the physics: which fingers touch an object, what rests
+    on one (:mod:`dial.backend.locate`), and the time."""
+    m, d = robot.model, robot.data
+    return Feeling(
+        lambda body, fingers: fingers_touching(m, d, body, fingers),
+        lambda body: resting_on(m, d, body),
+        lambda: robot.time,
+    )
+
+
+class Factory:
+    """The runner's primitive factory on a robot: each run's primitive or sensor, as its
+    event's record declares it (``Args.primitive``, ``Args.sensor``). Before each, the world
+    model carries what the hand holds to where the tool is, and lets go of what the fingers
+    no longer touch (nothing to do while nothing is held)."""
+
+    def __init__(self, ctx: Context) -> None:
+        self.ctx = ctx
+
+    def primitive(self, info: RunInfo) -> Primitive[Snapshot]:
+        self.ctx.refresh()
+        return info.event.args.primitive(self.ctx, info.allotment)
+
+    def sensor(self, info: RunInfo) -> Sensor[Snapshot]:
+        self.ctx.refresh()
+        return info.event.args.sensor(self.ctx)

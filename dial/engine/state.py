@@ -26,15 +26,15 @@ import mujoco
 import numpy as np
 
 from dial.backend.driver import MujocoRobot
+from dial.disturb import Disturbance, parse_disturbance
 from dial.errors import DialError
 from dial.parser.script import Script, Step, TBlock, TCall, TIf, TRepeat, scripts_of
-from dial.primitives import Context
-from dial.primitives.context import StopContact
+from dial.primitives.context import Context
+from dial.robot.snapshot import Touch
 from dial.scene.belief import Held
-from dial.scheduler.position import Frame, Resume
-from dial.scheduler.position import Path as TimelinePath
+from dial.scheduler.position import Frame, Resume, TimelinePath
+from dial.scheduler.primitive import Outcome
 from dial.scheduler.ticks import TickLoop
-from dial.scheduler.types import Outcome
 
 FORMAT, VERSION = "dial-state", 1
 PHYSICS = mujoco.mjtState.mjSTATE_INTEGRATION
@@ -64,7 +64,7 @@ class RunSettings:
     tick: float
     seed: int
     perturb_mm: float
-    disturb: tuple[str, ...]
+    disturb: tuple[Disturbance, ...]
 
 
 def _array(values: np.ndarray) -> str:
@@ -175,7 +175,7 @@ def save(
             "tick": settings.tick,
             "seed": settings.seed,
             "perturb_mm": settings.perturb_mm,
-            "disturb": list(settings.disturb),
+            "disturb": [d.text for d in settings.disturb],
         },
         "clock": {"periods": loop.periods, "clock": loop.clock, "tick": loop.tick},
         "latest": [[_key(script, s), e, o.value] for (s, e), o in loop.latest.items()],
@@ -202,7 +202,7 @@ def save(
 
 
 @dataclass(frozen=True)
-class Saved:
+class StateFile:
     """A state file as read: call :meth:`resume` on the script to go on with it."""
 
     source: Path
@@ -298,7 +298,7 @@ class Saved:
         robot.disturbances.resume_at(robot.steps)
         ctx.point_sets.update(d["contacts"])
         for f, (tactile, link) in d.get("stops", {}).items():
-            ctx.stops[int(f)] = StopContact(_stop_point(tactile), _stop_point(link))
+            ctx.stops[int(f)] = Touch(_stop_point(tactile), _stop_point(link))
         ctx.results.update(d["results"])
         _restore_beliefs(d, ctx)
 
@@ -346,7 +346,7 @@ def _restore_beliefs(d: dict[str, Any], ctx: Context) -> None:
         model.held[body] = Held(fingers, relative, grasped, str(held.get("on", "")))
 
 
-def load(source: Path) -> Saved:
+def load(source: Path) -> StateFile:
     """Read a state file; a one-line :class:`StateFileError` if it is not one dial can use."""
     try:
         data = json.loads(source.read_text(encoding="utf-8"))
@@ -363,9 +363,8 @@ def load(source: Path) -> Saved:
         )
     try:
         s = data["settings"]
-        settings = RunSettings(
-            float(s["tick"]), int(s["seed"]), float(s["perturb_mm"]), tuple(map(str, s["disturb"]))
-        )
+        disturb = tuple(parse_disturbance(str(text)) for text in s["disturb"])
+        settings = RunSettings(float(s["tick"]), int(s["seed"]), float(s["perturb_mm"]), disturb)
         for key in (
             "script",
             "block",
@@ -387,4 +386,4 @@ def load(source: Path) -> Saved:
             raise ValueError(f"block {data['block']!r}")
     except (KeyError, TypeError, ValueError) as e:
         raise StateFileError(f"state file '{source}' is corrupt or truncated ({e})") from None
-    return Saved(source, data, settings)
+    return StateFile(source, data, settings)

@@ -16,18 +16,15 @@ from difflib import get_close_matches
 from pathlib import Path
 
 from dial.errors import Diagnostic, ScriptError, Span
-from dial.instructions.catalogue import INSTRUCTIONS, Instruction
+from dial.instructions.base import Instruction, Values
+from dial.instructions.catalogue import INSTRUCTIONS, WATCHABLE
 from dial.instructions.scene_names import SceneLoader, SceneNames, SceneNotFoundError
-from dial.instructions.types import EFFECTORS, Name, Names
+from dial.instructions.types import EFFECTORS, Contact, Name, Names
 from dial.parser.ast import Call, Condition, Definition, ExecLine, Program
 from dial.parser.bind import bind
 from dial.parser.compile import compile_body, diagram_events
 from dial.parser.parse import parse_partial
 from dial.parser.script import EventDef, Script
-
-# The instructions whose condition holds or not at each moment, so that a monitor can sense
-# it every control period: the contact conditions (DESIGN 2.7).
-WATCHABLE = tuple(name for name, i in INSTRUCTIONS.items() if i.condition is not None)
 
 
 def _hint(name: str, valid: list[str]) -> str:
@@ -153,11 +150,16 @@ class _Checker:
         if errors:
             self.broken.add(d.event)
             return
+        args = instr.build(Values(bound.args))
+        problem = args.problem()
+        if problem is not None:
+            self.error(d.instruction_span, f"event '{d.event}': {problem}")
+            self.broken.add(d.event)
+            return
         if self.scene is not None and not self.scene_names(d.event, instr, bound.args, bound.spans):
             self.broken.add(d.event)
             return
-        effectors = instr.effectors(bound.args, self.scene)
-        self.events[d.event] = EventDef(d.event, instr, bound.args, effectors, d)
+        self.events[d.event] = EventDef(d.event, instr, args, args.effectors(self.scene), d)
 
     def scene_names(
         self, event: str, instr: Instruction, args: Mapping[str, object], spans: Mapping[str, Span]
@@ -230,7 +232,7 @@ class _Checker:
             )
         return event
 
-    def watched(self, line: ExecLine) -> bool:
+    def watched(self, line: ExecLine) -> Contact | None:
         event = self.events[line.event]
         instr = event.instruction
         if event.effectors or not instr.sensing:
@@ -240,16 +242,16 @@ class _Checker:
                 f"event '{line.event}' cannot be watched: '~' marks a sensing event, and "
                 f"'{line.event}' ({instr.name}) commands {what}",
             )
-            return False
-        if instr.condition is None:
+            return None
+        contact = event.args.contact()
+        if contact is None:
             self.error(
                 line.span_of(*line.watches[0]),
                 f"event '{line.event}' ({instr.name}) cannot be watched: only "
                 f"{', '.join(WATCHABLE[:-1])} and {WATCHABLE[-1]} can, because only a contact "
                 "condition holds or not at each moment",
             )
-            return False
-        return True
+        return contact
 
     def condition(self, cond: Condition | None) -> None:
         if cond is None or cond.event in self.broken:

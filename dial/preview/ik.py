@@ -26,7 +26,7 @@ from dial.backend.ik import (
     ArmIK,
     FingerIK,
 )
-from dial.backend.snapshot import FloatArray
+from dial.robot.snapshot import FloatArray
 
 LEAN_ITERATIONS = 30  # per start of LeanArmIK.solve, before it leaves one to mink
 

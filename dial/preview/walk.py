@@ -4,7 +4,7 @@ A block is walked as the runner walks it (tick by tick, runs started in line ord
 fixed-length run stepped every control period on its progress in tick time), with the
 set-points going straight to the pose: the arm and the fingers are where they are
 commanded. The pose is checked whenever it has moved a little (see :data:`ARM_STEP`), and
-at every period while a watched span is armed. Indeterminate runs are previewed at their
+at every period while a watched span is watched. Indeterminate runs are previewed at their
 start, at once (:mod:`dial.preview.motions`). Both branches of an ``@if`` are previewed from
 the same pose, and the walk goes on from the branch the previewed outcomes choose; every
 ``@on`` reaction is previewed from where its block ends (or where its monitor fired, from
@@ -14,26 +14,27 @@ which the walk then goes on); a loop's body once; a call's timeline in place.
 from __future__ import annotations
 
 from collections import defaultdict
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 
 from dial.backend.driver import CONTROL_PERIOD
-from dial.backend.snapshot import FloatArray, Snapshot
 from dial.errors import DialError
 from dial.parser.ast import Condition
-from dial.parser.script import EventDef, Run, Script, Step, TBlock, TCall, TIf, TOn, TRepeat, Watch
-from dial.preview import checks
-from dial.preview.motions import PreviewPuma, Report, grasp, guarded, sense
+from dial.parser.script import Run, Script, Step, TBlock, TCall, TIf, TOn, TRepeat, Watch
+from dial.preview.motions import sensed
+from dial.preview.moves import AtOnce, Making, P, Sensed, Stepped
 from dial.preview.places import Place, Places
 from dial.preview.report import Counts, Problems
 from dial.preview.scene import Hit, Scene, State, finger_group
-from dial.primitives import CLASSES
-from dial.primitives.arm import ArmMotion
-from dial.scheduler.types import Course, Now, Outcome, Primitive, RunInfo
+from dial.robot.protocol import Course
+from dial.robot.snapshot import FloatArray, Snapshot
+from dial.scheduler.primitive import Now, Outcome, Primitive, progress_after
+from dial.scheduler.types import RunInfo
 
 ARM_STEP = np.radians(0.25)  # rad of any arm joint between two checks of a moving pose
 HAND_STEP = np.radians(1.0)  # rad of any hand joint
@@ -42,7 +43,8 @@ Latest = dict[tuple[str, str], Outcome]
 
 @dataclass
 class Active:
-    """A fixed-length run being stepped: where it is written, and its progress."""
+    """A fixed-length run being stepped: where it is written, and its progress;
+    ``finished``: the problems with where it got; ``label``: what it does at a progress."""
 
     place: Place
     run: Run
@@ -50,11 +52,20 @@ class Active:
     effectors: frozenset[str]
     span: int  # its executing ticks, in control periods
     start_clock: int
+    finished: Callable[[], list[str]]
+    label: Callable[[float], str]
     progress: float = 0.0
 
 
+class Starting(NamedTuple):
+    """The run being started: where it is written, and its place in the timeline."""
+
+    place: Place
+    info: RunInfo
+
+
 @dataclass(frozen=True)
-class Saved:
+class Bookmark:
     """Where a walk is: the scene, the latest outcomes, the contacts going on and whose."""
 
     state: State
@@ -95,6 +106,7 @@ class Walk:
         self.ongoing: dict[tuple[str, str, str], tuple[Place, str]] = {}
         self.seen = (scene.robot.arm_target.copy(), scene.robot.hand_target.copy())
         self.places = Places()  # statement places, the world files read once per preview
+        self.starting: Starting | None = None  # the run a move is starting
 
     # -- the timeline ------------------------------------------------------------------------------
     def steps(self, script: Script, steps: tuple[Step, ...], label: str) -> None:
@@ -142,14 +154,16 @@ class Walk:
             self.why = before
 
     def test(self, script: Script, cond: Condition) -> bool:
-        if cond.event in script.condition_only:
-            self.latest[(script.path, cond.event)] = sense(self.scene, script.events[cond.event])
+        if cond.event in script.condition_only:  # a sensing event: sensed now
+            outcome = script.events[cond.event].args.preview().begin(self)
+            if outcome is not None:
+                self.latest[(script.path, cond.event)] = outcome
         return (self.latest.get((script.path, cond.event)) is Outcome.DONE) != cond.negated
 
-    def save(self) -> Saved:
-        return Saved(self.scene.save(), dict(self.latest), dict(self.ongoing))
+    def save(self) -> Bookmark:
+        return Bookmark(self.scene.save(), dict(self.latest), dict(self.ongoing))
 
-    def restore(self, saved: Saved) -> None:
+    def restore(self, saved: Bookmark) -> None:
         self.scene.restore(saved.state)
         self.latest, self.ongoing = dict(saved.latest), dict(saved.ongoing)
         self.seen = (self.scene.robot.arm_target.copy(), self.scene.robot.hand_target.copy())
@@ -163,17 +177,17 @@ class Walk:
         starts: dict[int, list[Run]] = defaultdict(list)
         for run in block.runs:
             starts[run.start].append(run)
-        armed: list[Watch] = []
+        watching: list[Watch] = []
         fired: TOn | None = None
         for k in range(1, block.length + 1):
-            armed += [w for w in block.watches if w.start == k]
+            watching += [w for w in block.watches if w.start == k]
             for run in starts[k]:
                 self.start(script, run)
-            fired = self.periods(script, block, k, armed)
+            fired = self.periods(script, block, k, watching)
             if fired is not None:
                 break
             self.finish(script, k)
-            armed = [w for w in armed if w.end != k]
+            watching = [w for w in watching if w.end != k]
         for a in self.active:
             if fired is not None:
                 self.latest[(a.place.path, a.run.event)] = Outcome.PREEMPTED
@@ -188,10 +202,10 @@ class Walk:
         self.panels.append(Panel(label, place, events, qpos, np.array(self.trace), problems, note))
         self.reactions(script, block, label, fired)
 
-    def periods(self, script: Script, block: TBlock, k: int, armed: list[Watch]) -> TOn | None:
+    def periods(self, script: Script, block: TBlock, k: int, watching: list[Watch]) -> TOn | None:
         """Step the runs executing in tick ``k``, period by period; a monitor that fires."""
         moving = [a for a in self.active if a.run.start <= k <= a.run.exec_end]
-        if not moving and not armed:
+        if not moving and not watching:
             self.clock += self.n
             return None
         snapshot = self.scene.robot.snapshot()
@@ -201,9 +215,9 @@ class Walk:
             for a, write in zip(moving, writes, strict=True):
                 a.progress = self.progress(a, self.clock)
                 write(i)
-            if armed:
+            if watching:
                 self.look()
-                fired = self.fires(script, block, armed)
+                fired = self.fires(script, block, watching)
                 if fired is not None:
                     return fired
             else:
@@ -211,31 +225,29 @@ class Walk:
         return None
 
     def progress(self, a: Active, clock: int) -> float:
-        """A run's progress in tick time at the end of period ``clock``, as the runner has it
-        (a one-tick run: a GOTO)."""
-        return 1.0 if a.span == self.n else min(1.0, (clock - a.start_clock) / a.span)
+        """A run's progress in tick time at the end of period ``clock``, as the runner has it."""
+        return progress_after(clock - a.start_clock, a.span, self.n)
 
     def course(self, a: Active, k: int, snapshot: Snapshot) -> Course:
         """A writer of the run's set-points in the ``i``-th period of tick ``k``: an open-loop
         run's course (what its step would write, bit for bit, worked out for the whole tick
         at once), else its step."""
         if a.prim.open_loop:
-            return a.prim.course([self.progress(a, self.clock + i) for i in range(1, self.n + 1)])
+            return a.prim.course(self.clock - a.start_clock + 1, self.n)
 
         def step(i: int) -> None:
             a.prim.step(snapshot, Now(0.0, k, a.progress, 0.0, False))
 
         return step
 
-    def fires(self, script: Script, block: TBlock, armed: list[Watch]) -> TOn | None:
+    def fires(self, script: Script, block: TBlock, watching: list[Watch]) -> TOn | None:
         """The first ``@on`` (in file order) whose watched contact condition holds now."""
         for on in block.reactions:
-            for watch in armed:
+            for watch in watching:
                 if watch.event != on.condition.event:
                     continue
-                finger = script.events[watch.event].args["finger"]
-                assert isinstance(finger, int)
-                if self.scene.touching({finger_group(finger)}) != on.condition.negated:
+                touching = self.scene.touching({finger_group(watch.contact.finger)})
+                if touching != on.condition.negated:
                     outcome = Outcome.MISSED if on.condition.negated else Outcome.DONE
                     self.latest[(script.path, on.condition.event)] = outcome
                     return on
@@ -258,68 +270,72 @@ class Walk:
                 keep = self.save()
         self.restore(keep)
 
-    # -- runs --------------------------------------------------------------------------------------
+    # -- runs: each instruction's record says how it moves (dial.preview.moves) -------------
     def start(self, script: Script, run: Run) -> None:
         event = script.events[run.event]
         place = Place(script.path, run.line, run.span.col or 1, run.event)
         for effector in event.effectors:
             self.owner[effector] = place
-        name, key = event.instruction.name, (script.path, run.event)
         self.scene.pose()
-        if name in ("guarded_move", "grasp_force"):
-            arm = name == "guarded_move" and not isinstance(event.args["finger"], int)
-            self.counts.arm += arm
-            self.counts.hand += not arm
-            self.latest[key] = self.at_once(place, event)
-            return
-        if event.instruction.length != "fixed":  # sensing, contact waits
-            self.latest[key] = sense(self.scene, event)
-            return
-        prim = self.primitive(RunInfo(event, run, script.path, self.n, CONTROL_PERIOD))
+        self.starting = Starting(place, RunInfo(event, run, script.path, self.n, CONTROL_PERIOD))
+        outcome = event.args.preview().begin(self)
+        if outcome is not None:
+            self.latest[(script.path, run.event)] = outcome
+
+    def stepped(self, move: Stepped[P]) -> Outcome | None:
+        """Start a fixed-length run's primitive; :meth:`periods` steps it from now on."""
+        assert self.starting is not None, "a move begins in Walk.start"
+        place, info = self.starting
+        written = " ".join(w.text for p in info.event.definition.params for w in p.words)
+        scene = self.scene
+        prim = move.make(Making(scene.ctx, info.allotment, self.places, written))
         try:
-            prim.start(self.scene.robot.snapshot())
+            prim.start(scene.robot.snapshot())
         except DialError as e:
             self.problems.add(place, str(e), self.why)
-            self.latest[key] = Outcome.ERROR
-            return
-        for message in checks.started(self.scene, prim, event):
+            return Outcome.ERROR
+        for message in move.started(scene, prim):
             self.problems.add(place, message, self.why)
-        if isinstance(prim, ArmMotion):
-            self.counts.arm += prim.targets if isinstance(prim, PreviewPuma) else 1
-        elif name != "limp":
-            self.counts.hand += 1
-        span = (run.exec_end - run.start + 1) * self.n
-        self.active.append(Active(place, run, prim, event.effectors, span, self.clock))
+        arm, hand = move.counts(prim)
+        self.counts.arm += arm
+        self.counts.hand += hand
 
-    def primitive(self, info: RunInfo) -> Primitive[Snapshot]:
-        """The run's own primitive; ``puma_command``'s planned a statement at a time."""
-        name = info.event.instruction.primitive
-        ctx = self.scene.ctx
-        if name == "PumaCommand":
-            return PreviewPuma(ctx, info, self.places)
-        made = CLASSES[name](ctx, info)
-        assert isinstance(made, Primitive), "a fixed-length instruction has a primitive"
-        return made
+        def finished() -> list[str]:
+            return move.finished(scene, prim)
 
-    def at_once(self, place: Place, event: EventDef) -> Outcome:
+        def label(progress: float) -> str:
+            return move.label(prim, progress)
+
+        effectors, span = info.event.effectors, info.span
+        self.active.append(
+            Active(place, info.run, prim, effectors, span, self.clock, finished, label)
+        )
+        return None
+
+    def at_once(self, move: AtOnce) -> Outcome:
         """A guarded move or a grasp, previewed whole now."""
-        self.current = place
+        assert self.starting is not None, "a move begins in Walk.start"
+        place = self.current = self.starting.place
+        self.counts.arm += move.arm
+        self.counts.hand += not move.arm
         try:
-            motion = guarded if event.instruction.name == "guarded_move" else grasp
-            report: Report = motion(self.scene, event, self.record)
+            found = move.motion(self.scene, self.record)
         finally:
             self.current = None
-        for message in report.problems:
+        for message in found.problems:
             self.problems.add(place, message, self.why)
         self.look()
-        return report.outcome
+        return found.outcome
+
+    def sensed(self, move: Sensed) -> Outcome:
+        return sensed(self.scene, move.finger)
 
     def finish(self, script: Script, k: int) -> None:
         """End the runs whose last executing tick ``k`` was."""
         for a in [a for a in self.active if a.run.exec_end == k]:
             self.scene.pose()
             ended = a.prim.finish(self.scene.robot.snapshot())
-            for message in (*ended.warnings, *checks.finished(self.scene, a.prim)):
+            for message in (*ended.warnings, *a.finished()):
                 self.problems.add(a.place, message, self.why)
             self.latest[(script.path, a.run.event)] = ended.outcome
             a.prim.stop()
@@ -366,8 +382,7 @@ class Walk:
             moving = [a for a in self.active if who in a.effectors]
             if moving:
                 a = moving[-1]
-                label = a.prim.label_at(a.progress) if isinstance(a.prim, PreviewPuma) else ""
-                return a.place, label
+                return a.place, a.label(a.progress)
         for who in movers:
             if who in self.owner:
                 return self.owner[who], ""

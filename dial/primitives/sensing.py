@@ -2,75 +2,74 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
+
 import numpy as np
 
-from dial.backend.contact import contact_reading
-from dial.backend.locate import finger_bodies, link_point, tactile_point
-from dial.backend.snapshot import FloatArray, Snapshot
-from dial.haptics import FitError, fit_plane, fit_superquadric
-from dial.instructions.catalogue import contact_condition
-from dial.instructions.types import FINGERS
+from dial.haptics import FitError, PlaneFit, SuperquadricFit
+from dial.instructions.types import FINGERS, Contact
 from dial.primitives.context import Context, RobotPrimitive, done, missed
-from dial.scheduler.types import Ended, Now, Outcome, RunInfo
+from dial.robot.contact import force_reading, position_reading, tactile_reading
+from dial.robot.snapshot import FloatArray, Snapshot
+from dial.scheduler.primitive import Allotment, Ended, Now, Outcome
 
 
 class Get:
-    """``get_joints``, ``get_forces``, ``get_tactile``, ``get_wrist``: record a snapshot."""
+    """``get_joints``, ``get_forces``, ``get_tactile``, ``get_wrist``: record what ``read``
+    takes from the snapshot."""
 
-    def __init__(self, ctx: Context, info: RunInfo) -> None:
-        self.what = info.event.instruction.name
+    def __init__(self, read: Callable[[Snapshot], dict[str, object]]) -> None:
+        self.read = read
 
     def sense(self, snapshot: Snapshot) -> Ended:
-        if self.what == "get_joints":
-            return done(hand_q=snapshot.hand_q, arm_q=snapshot.arm_q)
-        if self.what == "get_forces":
-            return done(tensions=snapshot.tensions)
-        if self.what == "get_tactile":
-            return done(tactile=snapshot.tactile)
-        return done(pos=snapshot.tool_pos, rot=snapshot.tool_rot)
+        return done(**self.read(snapshot))
 
 
-def contact_value(kind: str, snapshot: Snapshot, finger: int, baseline: FloatArray | None) -> float:
-    """The reading a contact condition compares with its threshold (m or N); a dropped-out
-    sensor reads 0, as the driver's guards read it."""
+NO_BASELINE = (0.0,) * 16  # a force reading measured from zero: the differentials' value
+
+
+def contact_value(contact: Contact, snapshot: Snapshot, baseline: Sequence[float]) -> float:
+    """The reading (m or N) a contact condition compares with its threshold, from the
+    snapshot (:mod:`dial.robot.contact`); a force reading is the change from ``baseline``
+    (16 differentials). A dropped-out sensor reads 0, as the robot's guards read it."""
+    kind, finger = contact.kind, contact.finger
     if (kind, finger) in snapshot.dropped:
         return 0.0
-    return contact_reading(
-        kind,
-        finger,
-        snapshot.tactile[finger],
-        snapshot.differentials,
-        snapshot.hand_target,
-        snapshot.hand_q,
-        baseline,
-    )
+    if kind == "tactile":
+        return tactile_reading(snapshot.tactile[finger])
+    if kind == "force":
+        return force_reading(snapshot.tensions.tolist(), baseline, finger)
+    return position_reading(snapshot.hand_target, snapshot.hand_q, finger)
 
 
 class ContactWait(RobotPrimitive):
-    """``position_contact``, ``force_contact``, ``tactile_contact``.
+    """``position_contact``, ``force_contact``, ``tactile_contact`` in a diagram: wait until
+    the contact is signalled (a force change counts from the run's start)."""
 
-    In a diagram: wait until the contact is signalled (a force change counts from the
-    run's start). As a condition-only event: is the contact there now (:meth:`sense`)?
-    """
-
-    def __init__(self, ctx: Context, info: RunInfo) -> None:
-        super().__init__(ctx, info)
-        self.kind, self.finger, self.threshold = contact_condition(
-            info.event.instruction, info.event.args
-        )
+    def __init__(self, ctx: Context, allotted: Allotment, contact: Contact) -> None:
+        super().__init__(ctx, allotted)
+        self.contact = contact
 
     def start(self, snapshot: Snapshot) -> None:
-        self.baseline = snapshot.differentials.copy()
+        self.baseline = snapshot.differentials.tolist()
 
     def step(self, snapshot: Snapshot, now: Now) -> Ended | None:
-        value = contact_value(self.kind, snapshot, self.finger, self.baseline)
-        return done(value=value) if value >= self.threshold else None
+        value = contact_value(self.contact, snapshot, self.baseline)
+        return done(value=value) if value >= self.contact.threshold else None
+
+
+class ContactTest:
+    """A contact instruction as a condition-only event: is the contact there now?"""
+
+    def __init__(self, contact: Contact) -> None:
+        self.contact = contact
 
     def sense(self, snapshot: Snapshot) -> Ended:
-        value = contact_value(self.kind, snapshot, self.finger, None)
-        if value >= self.threshold:
+        kind, finger, threshold = self.contact
+        value = contact_value(self.contact, snapshot, NO_BASELINE)
+        if value >= threshold:
             return done(value=value)
-        return missed(f"no {self.kind} contact on the {FINGERS[self.finger]}", value=value)
+        return missed(f"no {kind} contact on the {FINGERS[finger]}", value=value)
 
 
 class RecordContact:
@@ -81,14 +80,8 @@ class RecordContact:
     or as it was when the latest guarded move sensing this finger stopped (``at=stop``).
     """
 
-    def __init__(self, ctx: Context, info: RunInfo) -> None:
-        self.ctx = ctx
-        finger = info.event.args["finger"]
-        assert isinstance(finger, int)
-        self.finger = finger
-        self.set = str(info.event.args["into"])
-        self.at = str(info.event.args["at"])
-        self.source = str(info.event.args["source"])
+    def __init__(self, ctx: Context, finger: int, into: str, at: str, source: str) -> None:
+        self.ctx, self.finger, self.set, self.at, self.source = ctx, finger, into, at, source
 
     def sense(self, snapshot: Snapshot) -> Ended:
         name = FINGERS[self.finger]
@@ -98,7 +91,8 @@ class RecordContact:
                 return missed(f"no guarded move stopped on a contact of the {name}")
             point = stop.tactile if self.source == "tactile" else stop.link
         else:
-            point = self._now(snapshot)
+            touch = snapshot.touch(self.finger)
+            point = touch.tactile if self.source == "tactile" else touch.link
         if point is None:
             where = "fingertip array" if self.source == "tactile" else "links"
             when = "at the stop" if self.at == "stop" else "now"
@@ -106,12 +100,6 @@ class RecordContact:
         points = self.ctx.point_sets.setdefault(self.set, [])
         points.append([float(x) for x in point])
         return done(point=point, set=self.set, count=len(points))
-
-    def _now(self, snapshot: Snapshot) -> FloatArray | None:
-        robot = self.ctx.robot
-        if self.source == "tactile":  # a dropped-out array reads 0 in the snapshot
-            return tactile_point(snapshot.tactile[self.finger], robot.taxel_points(self.finger))
-        return link_point(robot.model, robot.data, finger_bodies(robot.model, self.finger))
 
 
 class Locate:
@@ -124,12 +112,8 @@ class Locate:
     the believed orientations are kept.
     """
 
-    def __init__(self, ctx: Context, info: RunInfo) -> None:
-        self.ctx = ctx
-        self.location = str(info.event.args["location"])
-        also = info.event.args["also"]
-        assert isinstance(also, tuple)
-        self.also = tuple(str(a) for a in also)
+    def __init__(self, ctx: Context, location: str, also: tuple[str, ...]) -> None:
+        self.ctx, self.location, self.also = ctx, location, also
 
     def sense(self, snapshot: Snapshot) -> Ended:
         world = self.ctx.world
@@ -153,27 +137,31 @@ class Locate:
 
 
 class Fit:
-    """``fit_plane SET`` and ``fit_superquadric SET``: least squares over a point set."""
+    """``fit_plane SET`` and ``fit_superquadric SET``: ``fit`` (least squares) over a point
+    set; with ``learns`` (an object's alias), the world model takes the fit as that object's
+    position and size (:mod:`dial.scene.belief`)."""
 
-    def __init__(self, ctx: Context, info: RunInfo) -> None:
-        self.ctx = ctx
-        self.set = str(info.event.args["set"])
-        self.kind = info.event.instruction.name
-        alias = info.event.args.get("object")
-        self.object = None if alias is None else str(alias)
+    def __init__(
+        self,
+        ctx: Context,
+        point_set: str,
+        fit: Callable[[FloatArray], PlaneFit | SuperquadricFit],
+        learns: str | None = None,
+    ) -> None:
+        self.ctx, self.set, self.fit, self.object = ctx, point_set, fit, learns
 
     def sense(self, snapshot: Snapshot) -> Ended:
         points = np.array(self.ctx.point_sets.get(self.set, []), dtype=np.float64).reshape(-1, 3)
         try:
-            fit = fit_plane(points) if self.kind == "fit_plane" else fit_superquadric(points)
+            fit = self.fit(points)
         except FitError as e:
             return Ended(Outcome.MISSED, f"point set '{self.set}': {e}")
         result = fit.as_result()
         self.ctx.results[self.set] = result
         if self.object is not None:  # the object measured: the world model learns it
             body, model = self.ctx.world.objects[self.object], self.ctx.world_model
-            self.ctx.refresh(snapshot.time)
-            if self.kind == "fit_plane":
+            self.ctx.refresh()
+            if isinstance(fit, PlaneFit):
                 model.learn_plane(body, result, snapshot.time, self.object)
             else:
                 model.learn_superquadric(body, result, points, snapshot.time, self.object)

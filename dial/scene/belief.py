@@ -32,6 +32,20 @@ from dial.scene.world import World
 Journal = Callable[[dict[str, object]], None]
 Touching = Callable[[str, tuple[int, ...]], int]  # (body, fingers) -> how many touch it
 Resting = Callable[[str], tuple[str, ...]]  # body -> the bodies resting on it (above it)
+
+
+@dataclass(frozen=True)
+class Feeling:
+    """What the world model asks of the robot's senses, given by the engine (primitives never
+    see the physics): how many of some fingers touch an object, which objects rest on one,
+    and the simulated time (for the records). Without them (the preview, a teaching session)
+    no grasp ever holds anything."""
+
+    touching: Touching = lambda body, fingers: 0
+    resting: Resting = lambda body: ()
+    time: Callable[[], float] = lambda: 0.0
+
+
 # A fit's contacts lie around its centre along an axis when their midrange is within this
 # fraction of their extent from it (a solid touched all round, or on its top and at its bottom
 # edge; not one touched from one side, or from the top down to below its middle only).
@@ -90,8 +104,10 @@ class Beliefs:
         sizes: dict[str, FloatArray] | None = None,
         journal: Journal | None = None,
         follow: bool = True,
+        feeling: Feeling | None = None,
     ) -> None:
         self.world, self.poses = world, poses
+        self.feeling = feeling or Feeling()
         self.sizes: dict[str, FloatArray] = {} if sizes is None else sizes
         self.held: dict[str, Held] = {}
         self.journal = journal
@@ -138,27 +154,20 @@ class Beliefs:
         self._note(body, why, before, t, name)
 
     # -- grasps ------------------------------------------------------------------------------
-    def grasp(
-        self,
-        tool: Pose,
-        fingers: tuple[int, ...],
-        touching: Touching,
-        resting: Resting,
-        t: float,
-    ) -> None:
+    def grasp(self, tool: Pose, fingers: tuple[int, ...]) -> None:
         """A grasp with ``fingers`` ended done: every object that two of them (its one finger)
         touch is held from now on, at its believed pose in the tool frame ``tool``, and so is
         every object resting on it (the home-robot seed's ownership: a lid on a pitcher)."""
         if not self.follow:
             return
-        self.update(tool, touching, t)
-        need = min(2, len(fingers))
+        self.update(tool)
+        need, t = min(2, len(fingers)), self.feeling.time()
         objects = dict.fromkeys(self.world.objects.values())
         for body in objects:
-            if body in self.held or touching(body, fingers) < need:
+            if body in self.held or self.feeling.touching(body, fingers) < need:
                 continue
             self._hold(body, Held(fingers, self._in(tool, body), self.poses[body]), "grasped", t)
-            for child in resting(body):
+            for child in self.feeling.resting(body):
                 if child in objects and child not in self.held:
                     held = Held(fingers, self._in(tool, child), self.poses[child], on=body)
                     self._hold(child, held, "carried", t)
@@ -170,11 +179,14 @@ class Beliefs:
         self.held[body] = held
         self._note(body, why, self.entry(body), t, "")
 
-    def update(self, tool: Pose, touching: Touching, t: float) -> None:
+    def update(self, tool: Pose) -> None:
         """Move every held object with the tool (at ``tool``), and release those its fingers
         no longer touch, and what rests on them: they stay where the hand left them."""
+        if not self.held:
+            return
         for body, held in self.held.items():
             self.poses[body] = compose(tool, held.relative)
+        touching, t = self.feeling.touching, self.feeling.time()
         let_go = [b for b, h in self.held.items() if not h.on and touching(b, h.fingers) == 0]
         let_go += [b for b, h in self.held.items() if h.on and (h.on in let_go)]
         for body in let_go:

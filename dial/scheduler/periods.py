@@ -8,7 +8,7 @@ a synchronous step object, so trio's task order cannot reach a result.
 When every active run is open-loop (:attr:`~dial.scheduler.types.Primitive.open_loop`: its
 set-points depend on its progress alone), the rest of the tick needs no snapshot and no
 step: the loop takes the runs' courses for those periods at once and the robot *coasts*
-through them (:meth:`~dial.scheduler.types.Robot.coast`), stopping early after any period
+through them (:meth:`~dial.robot.protocol.Clocked.coast`), stopping early after any period
 whose report says something. The periods, records and physics are the same as stepping
 them one by one; only the cost differs (see docs/architecture.md).
 """
@@ -23,22 +23,13 @@ import trio
 
 from dial.errors import DialError
 from dial.parser.script import Run, Script
+from dial.robot.protocol import Clocked, Course, Fired, Report
 from dial.scheduler.active import ActiveRun
 from dial.scheduler.position import Hooks, Resume
+from dial.scheduler.primitive import Ended, Now, Outcome, progress_after
 from dial.scheduler.records import Records
 from dial.scheduler.signals import StopRequest
-from dial.scheduler.types import (
-    Course,
-    Ended,
-    Fired,
-    Interrupted,
-    Now,
-    Outcome,
-    Report,
-    Robot,
-    RunAborted,
-    S,
-)
+from dial.scheduler.types import Interrupted, RunAborted, S
 
 ABORT_ON = frozenset({Outcome.TIMEOUT, Outcome.ERROR})
 OUTCOME_TEXT = {o: o.value for o in Outcome}  # a dict lookup is cheaper than Enum.value
@@ -58,7 +49,7 @@ class Periods(Generic[S]):
 
     def __init__(
         self,
-        robot: Robot[S],
+        robot: Clocked[S],
         n: int,
         records: Records,
         stop: StopRequest,
@@ -87,7 +78,7 @@ class Periods(Generic[S]):
 
     def progress_of(self, a: ActiveRun[S]) -> float:
         """A run's progress in tick time now (0 to 1)."""
-        return 1.0 if a.span == self.n else min(1.0, (self.clock - a.start_clock) / a.span)
+        return progress_after(self.clock - a.start_clock, a.span, self.n)
 
     def restore(self, resume: Resume) -> None:
         """Take up the clocks, outcomes and counts of a run saved at a block boundary."""
@@ -124,15 +115,7 @@ class Periods(Generic[S]):
         runs = [a for a in self.active if a.ended is None]
         if not all(a.prim.open_loop for a in runs):
             return None
-        n, clock = self.n, self.clock
-        return [
-            a.prim.course(
-                [1.0] * most
-                if a.span == n
-                else [min(1.0, (clock + j - a.start_clock) / a.span) for j in range(1, most + 1)]
-            )
-            for a in runs
-        ]
+        return [a.prim.course(self.clock - a.start_clock + 1, most) for a in runs]
 
     def _coast(self, writes: list[Course], most: int) -> tuple[Fired, ...]:
         """Periods as :meth:`_step` takes them, with the open-loop runs' set-points written
@@ -193,8 +176,7 @@ class Periods(Generic[S]):
             if a.ended is not None:
                 continue
             elapsed = (periods - a.start_period) * self.period
-            # A one-tick run is a GOTO MOVE: the set-point jumps at once.
-            progress = 1.0 if a.span == n else min(1.0, (clock - a.start_clock) / a.span)
+            progress = progress_after(clock - a.start_clock, a.span, n)
             try:
                 ended = a.prim.step(snapshot, Now(t_end, tick, progress, elapsed, stretched))
             except DialError as e:

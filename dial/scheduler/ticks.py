@@ -2,35 +2,25 @@
 
 A block's runs start in line order at their tick; every tick's control periods go through
 :class:`~dial.scheduler.periods.Periods`; a fixed-length run ends with its last executing
-tick, and an indeterminate one still going stretches it. A watched span arms its monitors
-in the robot; when one fires, the block is preempted and its ``@on`` reaction runs next.
+tick, and an indeterminate one still going stretches it. The robot watches the monitors of
+a watched span; when one fires, the block is preempted and its ``@on`` reaction runs next.
 """
 
 from __future__ import annotations
 
 from collections import defaultdict
 from dataclasses import dataclass
-from typing import NamedTuple, cast
+from typing import NamedTuple
 
 from dial.errors import DialError
 from dial.parser.script import Run, Script, TBlock, TOn, Watch
-from dial.scheduler.active import ActiveRun, RunPlan
+from dial.robot.protocol import Clocked, Course, Fired, Monitor
+from dial.scheduler.active import ActiveRun
 from dial.scheduler.periods import ABORT_ON, Observe, Periods, Progress
+from dial.scheduler.primitive import Ended, Outcome, Sensor
 from dial.scheduler.records import Records
 from dial.scheduler.signals import StopRequest
-from dial.scheduler.types import (
-    Course,
-    Ended,
-    Fired,
-    Monitor,
-    Outcome,
-    Primitive,
-    PrimitiveFactory,
-    Robot,
-    RunInfo,
-    S,
-    Sensor,
-)
+from dial.scheduler.types import PrimitiveFactory, RunInfo, S
 
 __all__ = ["Observe", "Preempted", "Progress", "TickLoop"]
 
@@ -56,7 +46,7 @@ class TickLoop(Periods[S]):
 
     def __init__(
         self,
-        robot: Robot[S],
+        robot: Clocked[S],
         factory: PrimitiveFactory[S],
         n: int,
         records: Records,
@@ -68,7 +58,7 @@ class TickLoop(Periods[S]):
         super().__init__(robot, n, records, stop, observe, pace)
         self.factory, self.progress = factory, progress
         self._plans: dict[int, _Plan] = {}
-        self._runs: dict[tuple[str, int], RunPlan] = {}
+        self._runs: dict[tuple[str, int], RunInfo] = {}
 
     # -- one block ------------------------------------------------------------------------------
     async def block(self, script: Script, block: TBlock) -> Preempted | None:
@@ -85,7 +75,7 @@ class TickLoop(Periods[S]):
                     await self.hooks.before_tick(self.tick, script, plan.starts.get(k, ()))
                     self._raise_pending()  # a signal while paused
                 for watch in plan.watch_from.get(k, ()):
-                    self._arm(script, block, watch, monitors)
+                    self._watch(script, block, watch, monitors)
                 for run in plan.starts.get(k, ()):
                     self._start(script, run)
                 self._raise_pending()
@@ -108,12 +98,12 @@ class TickLoop(Periods[S]):
                         return await self._preempted(script, block, fired, monitors, k, t0, stretch)
                     stretching = any(a.info.run.exec_end == k for a in self.active)
                 for watch in plan.watch_to.get(k, ()):
-                    self._disarm(monitors, watch)
+                    self._unwatch(monitors, watch)
                 self._tick_done(k, t0, stretch, preempted=False)
             return None
         finally:
             for key in monitors:
-                self.robot.disarm(key)
+                self.robot.unwatch(key)
 
     def _quiet(self, plan: _Plan, k: int, length: int) -> int:
         """How many ticks after tick ``k`` can be coasted along with it: while no run starts
@@ -174,26 +164,27 @@ class TickLoop(Periods[S]):
         self.records.tick(self.tick, k, t0, self.sim_time, stretch, preempted)
 
     # -- starting and sensing runs ------------------------------------------------------------
-    def _run_plan(self, script: Script, run: Run) -> RunPlan:
+    def _info(self, script: Script, run: Run) -> RunInfo:
+        """The run's place, worked out once per run of the timeline."""
         key = (script.path, id(run))
-        plan = self._runs.get(key)
-        if plan is None:
+        info = self._runs.get(key)
+        if info is None:
             event = script.events[run.event]
-            info = RunInfo(event, run, script.path, self.n, self.period)
-            plan = self._runs[key] = RunPlan.of(info)
-        return plan
+            info = self._runs[key] = RunInfo(event, run, script.path, self.n, self.period)
+        return info
 
     def _start(self, script: Script, run: Run) -> None:
         """Start a run in line order; a sensing run happens at once."""
-        plan = self._run_plan(script, run)
-        prim = self.factory(plan.info)
+        info = self._info(script, run)
         self.counts["runs"] += 1
-        self.records.start(script.path, run, self.tick, self.sim_time)
-        if plan.info.event.instruction.length == "zero":
-            self._sense(script, run, cast("Sensor[S]", prim))
+        if info.event.instruction.length == "zero":
+            sensor = self.factory.sensor(info)
+            self.records.start(script.path, run, self.tick, self.sim_time)
+            self._sense(script, run, sensor)
             return
-        prim_s = cast("Primitive[S]", prim)  # quoted: Primitive[S] at run time costs 0.3 us
-        active = ActiveRun(script, plan, prim_s, self.tick, self.periods, self.clock)
+        prim = self.factory.primitive(info)
+        self.records.start(script.path, run, self.tick, self.sim_time)
+        active = ActiveRun(script, info, prim, self.tick, self.periods, self.clock)
         self.active.append(active)  # from here on, its stop runs whatever happens
         try:
             active.prim.start(self._snapshot())
@@ -202,9 +193,8 @@ class TickLoop(Periods[S]):
 
     def sense(self, script: Script, run: Run) -> None:
         """Sense a condition-only event now, with zero duration (no start record)."""
-        info = RunInfo(script.events[run.event], run, script.path, self.n, self.period, True)
-        sensor = cast("Sensor[S]", self.factory(info))
-        self._sense(script, run, sensor)
+        info = RunInfo(script.events[run.event], run, script.path, self.n, self.period)
+        self._sense(script, run, self.factory.sensor(info))
 
     def _sense(self, script: Script, run: Run, sensor: Sensor[S]) -> None:
         try:
@@ -234,18 +224,17 @@ class TickLoop(Periods[S]):
         return stretching
 
     # -- monitors and preemption (DESIGN 2.7) -------------------------------------------------
-    def _arm(
+    def _watch(
         self, script: Script, block: TBlock, watch: Watch, monitors: dict[int, tuple[int, Watch]]
     ) -> None:
-        event = script.events[watch.event]
         for index, on in enumerate(block.reactions):
             if on.condition.event == watch.event:
-                key = self.robot.arm(Monitor(event, on.condition.negated))
-                monitors[key] = (index, watch)
+                monitor = Monitor(watch.event, watch.contact, on.condition.negated)
+                monitors[self.robot.watch(monitor)] = (index, watch)
 
-    def _disarm(self, monitors: dict[int, tuple[int, Watch]], watch: Watch) -> None:
+    def _unwatch(self, monitors: dict[int, tuple[int, Watch]], watch: Watch) -> None:
         for key in [k for k, (_, w) in monitors.items() if w is watch]:
-            self.robot.disarm(key)
+            self.robot.unwatch(key)
             del monitors[key]
 
     async def _preempted(

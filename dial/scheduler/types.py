@@ -1,113 +1,22 @@
-"""The contract between the runner, the primitives and the robot.
+"""What the runner knows of a run's place in the script, and how a script stops early.
 
-The runner knows nothing of MuJoCo: it drives any :class:`Robot` over a snapshot type
-``S`` of the robot's choosing, and builds a :class:`Primitive` (or a :class:`Sensor`, for
-zero-length sensing) per run through a :data:`PrimitiveFactory`.
+The runner knows nothing of MuJoCo: it drives a robot's :class:`~dial.robot.protocol.Clocked`
+face over a snapshot type ``S`` of the robot's choosing, and has each run's
+:class:`~dial.scheduler.primitive.Primitive` (or :class:`~dial.scheduler.primitive.Sensor`,
+for zero-length sensing) made through its :class:`Makers`.
 """
 
 from __future__ import annotations
 
-from abc import ABC, abstractmethod
-from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field
-from enum import StrEnum
-from typing import Generic, NamedTuple, Protocol, TypeVar
+from dataclasses import dataclass
+from typing import Protocol, TypeVar
 
 from dial.errors import DialError
 from dial.parser.script import EventDef, Run
-from dial.scheduler.signals import StopRequest
+from dial.scheduler.primitive import Allotment, Primitive, Sensor
 
 S = TypeVar("S")
-S_co = TypeVar("S_co", covariant=True)
 S_contra = TypeVar("S_contra", contravariant=True)
-
-# What a run reports for the log: JSON-able values (numbers, strings, lists, arrays).
-Data = Mapping[str, object]
-
-
-class Outcome(StrEnum):
-    """How a run ended (DESIGN 2.5, 2.7)."""
-
-    DONE = "done"
-    MISSED = "missed"
-    TIMEOUT = "timeout"
-    ERROR = "error"
-    PREEMPTED = "preempted"
-
-
-@dataclass(frozen=True, slots=True)
-class Ended:
-    """A run's outcome, with a message for ``error``, any sensed data to log, and warnings
-    (each becomes a ``warning`` record: a run that did not quite do what was asked never
-    ends silently ``done``)."""
-
-    outcome: Outcome
-    message: str = ""
-    data: Data = field(default_factory=dict)
-    warnings: tuple[str, ...] = ()
-
-
-DONE = Ended(Outcome.DONE)
-
-
-class Now(NamedTuple):
-    """What a primitive knows of time in one control period.
-
-    ``progress`` is the run's progress through its executing ticks in **tick time** (0 at
-    its start, 1 at the end of its last ``#``/``=`` tick); it stands still while a tick is
-    stretched. ``elapsed`` is simulated time since the run started (s), which never does.
-    ``sim_time`` is the simulated time at the end of this period (s).
-    """
-
-    sim_time: float
-    tick: int
-    progress: float
-    elapsed: float
-    stretched: bool
-
-
-Course = Callable[[int], None]  # writes the k-th coasted period's set-points (Primitive.course)
-
-
-class Primitive(ABC, Generic[S_contra]):
-    """One run of an instruction, stepped synchronously by the runner.
-
-    Lifecycle: :meth:`start` once; :meth:`step` every control period until it returns an
-    :class:`Ended` (or, for fixed-length runs, until the runner calls :meth:`finish` at the
-    end of the last executing tick); :meth:`stop` always, exactly once, after the run ends
-    for whatever reason (done, timeout, error, preempted, abort, interrupt). A step reads
-    the immutable snapshot and writes only its own effectors' command slots.
-    """
-
-    def start(self, snapshot: S_contra) -> None:
-        """Plan the run from the snapshot at its first period."""
-
-    @abstractmethod
-    def step(self, snapshot: S_contra, now: Now) -> Ended | None:
-        """Write this period's commands; return an outcome to end the run."""
-
-    def finish(self, snapshot: S_contra) -> Ended:
-        """End a fixed-length run at the end of its last executing tick."""
-        return DONE
-
-    #: An open-loop run's steps read nothing of the snapshot and never end it: its set-points
-    #: are a function of its progress alone, so the runner may take them in one go (coast).
-    open_loop: bool = False
-
-    def course(self, progress: Sequence[float]) -> Course:
-        """An open-loop run's writer of the set-points that :meth:`step` would write in the
-        coming periods, at these progress values (one per period, in order): calling it with
-        ``k`` writes the ``k``-th period's and leaves the run as if stepped through it."""
-        raise NotImplementedError(f"{type(self).__name__} is not open-loop")
-
-    def stop(self) -> None:
-        """Clean up; the effectors keep holding their last command."""
-
-
-class Sensor(Protocol[S_contra]):
-    """A zero-length run or a condition test: sensed at once, at the start of its tick."""
-
-    def sense(self, snapshot: S_contra) -> Ended: ...
 
 
 @dataclass(frozen=True)
@@ -119,112 +28,38 @@ class RunInfo:
     script: str
     periods_per_tick: int
     period: float
-    instant: bool = False  # sensed once with zero duration (a sensing run or condition test)
 
     @property
     def span(self) -> int:
         """The run's executing ticks, in control periods (a one-tick run's is one tick)."""
         return (self.run.exec_end - self.run.start + 1) * self.periods_per_tick
 
-
-PrimitiveFactory = Callable[[RunInfo], "Primitive[S] | Sensor[S]"]
-
-
-class Happening(NamedTuple):
-    """Something the robot observed during a period, for the runner to log.
-
-    ``kind`` is the record kind (``contact``, ``thread``, ``warning``); ``fields`` its
-    fields, with the simulated time ``t`` of the physics step where it happened.
-    """
-
-    kind: str
-    fields: Data
-
-
-class Fired(NamedTuple):
-    """A monitor whose condition held at a physics step of the period."""
-
-    key: int
-    time: float
-    step: int
-
-
-class Report(NamedTuple):
-    """What happened during one control period, when anything did (else ``advance`` -> None).
-
-    ``fault``: an engine-owned safety monitor tripped (joint or tension limit, non-finite
-    state); the runner aborts. ``fired``: monitors, in the order they were armed.
-    """
-
-    fault: str | None = None
-    happenings: tuple[Happening, ...] = ()
-    fired: tuple[Fired, ...] = ()
-
-
-class Monitor(NamedTuple):
-    """A live condition the robot tests at every physics step while it is armed.
-
-    ``event`` is the watched sensing event; the robot fires when its condition holds
-    (``negated``: when it does not).
-    """
-
-    event: EventDef
-    negated: bool
-
-
-class Robot(Protocol[S_co]):
-    """What the runner needs of a robot backend. Every call is synchronous."""
+    @property
+    def fixed(self) -> bool:
+        """A fixed-length run: it ends with its last executing tick."""
+        return self.event.instruction.length == "fixed"
 
     @property
-    def period(self) -> float:
-        """The control period in seconds."""
+    def timeout(self) -> float | None:
+        """Simulated s after which the run ends ``timeout``: only indeterminate runs time out."""
+        return None if self.fixed else self.event.args.time_limit()
+
+    @property
+    def allotment(self) -> Allotment:
+        """What the run's primitive is allotted: its effectors and its span."""
+        return Allotment(self.event.effectors, self.span, self.periods_per_tick, self.period)
+
+
+class PrimitiveFactory(Protocol[S_contra]):
+    """Makes each run's primitive, or sensor, as its event's instruction declares it."""
+
+    def primitive(self, info: RunInfo) -> Primitive[S_contra]:
+        """A run of a fixed-length or indeterminate instruction."""
         ...
 
-    def snapshot(self) -> S_co:
-        """An immutable view of the sensors for this control period."""
+    def sensor(self, info: RunInfo) -> Sensor[S_contra]:
+        """A zero-length run, or a condition-only event tested once (no start record)."""
         ...
-
-    def advance(self) -> Report | None:
-        """Apply the command slots and simulate one control period."""
-        ...
-
-    def coast(
-        self, writes: Sequence[Course], periods: int, stop: StopRequest
-    ) -> tuple[int, Report | None]:
-        """``advance`` up to ``periods`` times, each after ``write(k)`` of every course for
-        the k-th period; return after a period that reports anything, or once ``stop`` has a
-        signal: (periods taken, that report or None)."""
-        ...
-
-    def hold_all(self) -> None:
-        """Freeze every effector where it is measured now (abort, interrupt)."""
-        ...
-
-    def hold(self, effectors: frozenset[str]) -> None:
-        """Freeze these effectors where they are measured now (preemption)."""
-        ...
-
-    def arm(self, monitor: Monitor) -> int:
-        """Start testing a monitor every physics step; returns its key."""
-        ...
-
-    def disarm(self, key: int) -> None:
-        """Stop testing a monitor."""
-        ...
-
-
-def advance_through(
-    robot: Robot[object], writes: Sequence[Course], periods: int, stop: StopRequest
-) -> tuple[int, Report | None]:
-    """:meth:`Robot.coast` done with :meth:`Robot.advance`, one period after another: what a
-    robot with no faster way of its own does."""
-    for k in range(periods):
-        for write in writes:
-            write(k)
-        report = robot.advance()
-        if report is not None or stop.signal is not None:
-            return k + 1, report
-    return periods, None
 
 
 class RunAborted(DialError):

@@ -21,22 +21,11 @@ import trio.testing
 from dial.instructions.types import EFFECTORS
 from dial.parser.check import check_text
 from dial.parser.script import Script
+from dial.robot.protocol import Course, Fired, Monitor, Report, StopFlag, advance_through
 from dial.scheduler.log import EventLog, Record
-from dial.scheduler.runner import Runner, RunSummary
-from dial.scheduler.signals import StopRequest
-from dial.scheduler.types import (
-    Course,
-    Ended,
-    Fired,
-    Monitor,
-    Now,
-    Outcome,
-    Primitive,
-    Report,
-    RunInfo,
-    Sensor,
-    advance_through,
-)
+from dial.scheduler.primitive import Ended, Now, Outcome, Primitive, Sensor, progress_after
+from dial.scheduler.runner import Runner, Tally
+from dial.scheduler.types import RunInfo
 
 
 class FakeSnapshot(NamedTuple):
@@ -66,7 +55,7 @@ class FakeRobot:
         self.fault_at = dict(fault_at or {})
         self.conditions = dict(holds or {})
         self.monitors: dict[int, Monitor] = {}
-        self.armed: list[tuple[int, str, bool]] = []  # (period, event, negated), as armed
+        self.watched: list[tuple[int, str, bool]] = []  # (period, event, negated), as watched
         self._keys = itertools.count(1)
         self.stops: list[str] = []  # events whose run was stopped, in order
         self.coasts: list[tuple[int, int]] = []  # each coast's first period and length asked
@@ -87,12 +76,12 @@ class FakeRobot:
         fired = tuple(
             Fired(key, periods * self._period, periods)
             for key, m in self.monitors.items()
-            if (periods in self.conditions.get(m.event.name, ())) != m.negated
+            if (periods in self.conditions.get(m.event, ())) != m.negated
         )
         return Report(fault, (), fired) if fault is not None or fired else None
 
     def coast(
-        self, writes: Sequence[Course], periods: int, stop: StopRequest
+        self, writes: Sequence[Course], periods: int, stop: StopFlag
     ) -> tuple[int, Report | None]:
         self.coasts.append((self.periods + 1, periods))
         return advance_through(self, writes, periods, stop)
@@ -103,13 +92,13 @@ class FakeRobot:
     def hold(self, effectors: frozenset[str]) -> None:
         self.holds_at.append((self.periods, effectors))
 
-    def arm(self, monitor: Monitor) -> int:
+    def watch(self, monitor: Monitor) -> int:
         key = next(self._keys)
         self.monitors[key] = monitor
-        self.armed.append((self.periods + 1, monitor.event.name, monitor.negated))
+        self.watched.append((self.periods + 1, monitor.event, monitor.negated))
         return key
 
-    def disarm(self, key: int) -> None:
+    def unwatch(self, key: int) -> None:
         self.monitors.pop(key, None)
 
 
@@ -135,6 +124,7 @@ class _Motion(Primitive[FakeSnapshot]):
         self.commands, self.effectors = robot.commands, info.event.effectors
         self.stops = robot.stops
         self.name = info.event.name
+        self.span, self.n = info.span, info.periods_per_tick
 
     def step(self, snapshot: FakeSnapshot, now: Now) -> Ended | None:
         for effector in self.effectors:
@@ -143,7 +133,10 @@ class _Motion(Primitive[FakeSnapshot]):
 
     open_loop = True
 
-    def course(self, progress: Sequence[float]) -> Course:
+    def course(self, first: int, count: int) -> Course:
+        span, n = self.span, self.n
+        progress = [progress_after(k, span, n) for k in range(first, first + count)]
+
         def write(k: int) -> None:
             for effector in self.effectors:
                 self.commands[effector] = progress[k]
@@ -191,21 +184,20 @@ class FakeFactory:
             self._calls[event] = itertools.chain(outs, itertools.repeat(outs[-1]))
         return next(self._calls[event])
 
-    def __call__(self, info: RunInfo) -> Primitive[FakeSnapshot] | Sensor[FakeSnapshot]:
-        name = info.event.name
-        behaviour = self.behaviours.get(name, _DEFAULT)
-        length = info.event.instruction.length
-        if length == "fixed":
+    def primitive(self, info: RunInfo) -> Primitive[FakeSnapshot]:
+        if info.event.instruction.length == "fixed":
             return _Motion(self.robot, info)
-        outcome = self._next(name, behaviour)
-        if length == "zero" or info.instant:
-            return _Sense(outcome, behaviour.message)
-        return _Wait(self.robot, info, behaviour, outcome)
+        behaviour = self.behaviours.get(info.event.name, _DEFAULT)
+        return _Wait(self.robot, info, behaviour, self._next(info.event.name, behaviour))
+
+    def sensor(self, info: RunInfo) -> Sensor[FakeSnapshot]:
+        behaviour = self.behaviours.get(info.event.name, _DEFAULT)
+        return _Sense(self._next(info.event.name, behaviour), behaviour.message)
 
 
 @dataclass
 class FakeResult:
-    summary: RunSummary
+    summary: Tally
     log: EventLog
     robot: FakeRobot
     trio_time: float

@@ -11,7 +11,7 @@ import pytest
 
 from dial.geometry import Pose, rpy_matrix
 from dial.scene import models_dir
-from dial.scene.belief import Beliefs, initial
+from dial.scene.belief import Beliefs, Feeling, initial
 from dial.scene.world import World, load_world
 
 WORLDS = models_dir() / "utah_hand_puma" / "worlds"
@@ -21,10 +21,12 @@ def _pose(x: float, y: float, z: float, yaw_deg: float = 0.0) -> Pose:
     return np.array([x, y, z]), rpy_matrix((0.0, 0.0, math.radians(yaw_deg)))
 
 
-def _beliefs(world: World, follow: bool = True) -> tuple[Beliefs, list[dict[str, object]]]:
+def _beliefs(
+    world: World, follow: bool = True, feeling: Feeling | None = None
+) -> tuple[Beliefs, list[dict[str, object]]]:
     poses = {body: _pose(0.5, 0.0, 0.4) for body in world.objects.values()}
     records: list[dict[str, object]] = []
-    return Beliefs(world, poses, journal=records.append, follow=follow), records
+    return Beliefs(world, poses, journal=records.append, follow=follow, feeling=feeling), records
 
 
 @pytest.fixture(scope="module")
@@ -33,25 +35,27 @@ def pour() -> World:
 
 
 def test_a_grasped_object_follows_the_tool_and_stays_where_it_is_let_go(pour: World) -> None:
-    beliefs, records = _beliefs(pour)
     contact = {"pour_pitcher": 2}  # fingers on each body
-
-    def touching(body: str, fingers: tuple[int, ...]) -> int:
-        return contact.get(body, 0)
-
+    clock = [1.0]
+    feeling = Feeling(
+        lambda body, fingers: contact.get(body, 0), lambda body: ("pour_lid",), lambda: clock[0]
+    )
+    beliefs, records = _beliefs(pour, feeling=feeling)
     tool = _pose(0.39, 0.0, 0.49)
-    beliefs.grasp(tool, (1, 3), touching, lambda body: ("pour_lid",), 1.0)
+    beliefs.grasp(tool, (1, 3))
     assert set(beliefs.held) == {"pour_pitcher", "pour_lid"}  # the lid rests on it
     moved = _pose(0.39, -0.1, 0.52, yaw_deg=90.0)  # carried 100 mm, raised, turned
-    beliefs.update(moved, touching, 2.0)
+    clock[0] = 2.0
+    beliefs.update(moved)
     pos, rot = beliefs.poses["pour_pitcher"]
     # 110 mm in front of the tool, turned with it: now 110 mm along +y of it.
     assert np.allclose(pos, [0.39 - 0.0, -0.1 + 0.11, 0.43], atol=1e-12)
     assert np.allclose(rot, rpy_matrix((0.0, 0.0, math.pi / 2)))
     contact.clear()  # the hand opened (where it was): both are let go where it left them
-    beliefs.update(moved, touching, 3.0)
+    clock[0] = 3.0
+    beliefs.update(moved)
     assert not beliefs.held
-    beliefs.update(_pose(0.2, 0.0, 0.8), touching, 4.0)  # the hand goes; they stay
+    beliefs.update(_pose(0.2, 0.0, 0.8))  # the hand goes; they stay
     assert np.allclose(beliefs.poses["pour_pitcher"][0], [0.39, 0.01, 0.43])
     assert np.allclose(beliefs.poses["pour_lid"][0], [0.39, 0.01, 0.43])
     assert [(r["object"], r["why"]) for r in records] == [
@@ -67,14 +71,20 @@ def test_a_grasped_object_follows_the_tool_and_stays_where_it_is_let_go(pour: Wo
 
 
 def test_one_finger_on_an_object_does_not_hold_it(pour: World) -> None:
-    beliefs, records = _beliefs(pour)
-    beliefs.grasp(_pose(0.4, 0, 0.5), (1, 3), lambda b, f: 1, lambda b: (), 1.0)
+    beliefs, records = _beliefs(pour, feeling=Feeling(lambda b, f: 1))
+    beliefs.grasp(_pose(0.4, 0, 0.5), (1, 3))
     assert not beliefs.held and not records and not beliefs.changed
 
 
 def test_following_switched_off_changes_nothing(pour: World) -> None:
-    beliefs, records = _beliefs(pour, follow=False)
-    beliefs.grasp(_pose(0.4, 0, 0.5), (1, 3), lambda b, f: 2, lambda b: (), 1.0)
+    beliefs, records = _beliefs(pour, follow=False, feeling=Feeling(lambda b, f: 2))
+    beliefs.grasp(_pose(0.4, 0, 0.5), (1, 3))
+    assert not beliefs.held and not records
+
+
+def test_without_senses_nothing_is_ever_held(pour: World) -> None:
+    beliefs, records = _beliefs(pour)  # the preview's and a teaching session's world model
+    beliefs.grasp(_pose(0.4, 0, 0.5), (1, 3))
     assert not beliefs.held and not records
 
 
