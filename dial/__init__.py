@@ -13,7 +13,7 @@ The public API (docs/api.md)::
 
 from typing import TYPE_CHECKING
 
-from dial.api import load, run
+from dial.api import load, run, save_world
 from dial.errors import Diagnostic, DialError, OptionError, ScriptError, Span
 from dial.parser.script import Script
 
@@ -34,6 +34,7 @@ __all__ = [
     "__version__",
     "load",
     "run",
+    "save_world",
 ]
 _ENGINE = ("Observer", "RunResult", "Watched")
 

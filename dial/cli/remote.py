@@ -210,6 +210,7 @@ def check_remote(args: argparse.Namespace) -> None:
         "--record": args.record,  # not yet: the predicted and the reported robot together
         "--rerun": args.rerun,
         "--dataset": args.dataset,  # a local run's episode; the robot's telemetry is decimated
+        "--save-world": args.save_world,  # the world model is the robot's
     }
     given = [flag for flag, value in local.items() if value]
     if given:

@@ -14,8 +14,10 @@ import numpy as np
 from dial.backend.disturb import Disturbances
 from dial.backend.driver import MujocoRobot
 from dial.backend.ik import ArmIK, FingerIK
+from dial.backend.locate import fingers_touching, resting_on
 from dial.backend.model import (
     RobotIndex,
+    finger_bodies,
     load_model,
     profile_at,
     rest_hand,
@@ -26,6 +28,7 @@ from dial.geometry import Pose, location_pose, rpy_matrix
 from dial.parser.script import Script
 from dial.primitives.context import Context
 from dial.robot.snapshot import Snapshot
+from dial.scene.belief import Beliefs, Feeling, initial
 from dial.scene.of_script import script_world
 from dial.scene.resolve import bundled_name
 from dial.scene.thread import set_turns
@@ -67,8 +70,10 @@ def prepare(
     perturb_mm: float = 0.0,
     seed: int = 0,
     disturbances: Sequence[Disturbance] = (),
+    follow: bool = True,
 ) -> tuple[MujocoRobot, Context]:
-    """Load the scene, place the robot at home, perturb, settle; log the ``scene`` record."""
+    """Load the scene, place the robot at home, perturb, settle; log the ``scene`` record.
+    ``follow=False``: grasped objects do not follow the hand in the world model."""
     world = script_world(script)
     profile = profile_at(world.robot)
     model = load_model(world.model_path, profile)
@@ -77,10 +82,11 @@ def prepare(
     index = RobotIndex.from_model(model, profile)
     unmoved = mujoco.MjData(model)
     mujoco.mj_forward(model, unmoved)
-    believed: dict[str, Pose] = {
+    at_load: dict[str, Pose] = {
         model.body(b).name: (unmoved.xpos[b].copy(), unmoved.xmat[b].reshape(3, 3).copy())
         for b in scene_bodies(model, world)
     }
+    believed, sizes = initial(world, at_load)
     shift = perturb(model, world, perturb_mm, seed)
     data = mujoco.MjData(model)
     ik = ArmIK(profile=profile)
@@ -101,18 +107,36 @@ def prepare(
     where = f"{bundled}.toml" if bundled else str(world.path)
     log.write("scene", scene=world.name, world=where, perturb=shift, seed=seed)
     robot = MujocoRobot(model, data, disturbances=placed, profile=profile)
-    return robot, Context(robot, robot.view, world, believed, ik, FingerIK(profile=profile))
+    beliefs = Beliefs(world, believed, sizes, follow=follow, feeling=feeling(robot))
+    fik = FingerIK(profile=profile)
+    return robot, Context(robot, robot.view, world, believed, ik, fik, beliefs=beliefs)
+
+
+def feeling(robot: MujocoRobot) -> Feeling:
+    """What the world model asks of the physics: which fingers touch an object, what rests
+    on one (:mod:`dial.backend.locate`), and the time."""
+    m, d = robot.model, robot.data
+    links = [frozenset(finger_bodies(m, f.joints)) for f in robot.index.profile.fingers]
+    return Feeling(
+        lambda body, fingers: fingers_touching(m, d, body, [links[f] for f in fingers]),
+        lambda body: resting_on(m, d, body),
+        lambda: robot.time,
+    )
 
 
 class Factory:
     """The runner's primitive factory on a robot: each run's primitive or sensor, as its
-    event's record declares it (``Args.primitive``, ``Args.sensor``)."""
+    event's record declares it (``Args.primitive``, ``Args.sensor``). Before each, the world
+    model carries what the hand holds to where the tool is, and lets go of what the fingers
+    no longer touch (nothing to do while nothing is held)."""
 
     def __init__(self, ctx: Context) -> None:
         self.ctx = ctx
 
     def primitive(self, info: RunInfo) -> Primitive[Snapshot]:
+        self.ctx.refresh()
         return info.event.args.primitive(self.ctx, info.allotment)
 
     def sensor(self, info: RunInfo) -> Sensor[Snapshot]:
+        self.ctx.refresh()
         return info.event.args.sensor(self.ctx)

@@ -4,10 +4,9 @@ recording or a live stream to a viewer.
 Entity paths:
 
 - ``world``: the scene, z up, every geometry solid. ``world/<body>`` holds a body's pose in
-  the world frame: ``world/arm/link2``, ``world/hand/index_distal`` (a robot's bodies by the
-  prefix of its joints' names: ``puma_``, ``hand_``; ``panda_``, ``allegro_``), a scene
-  object by its alias (``world/bulb``), ``world/scene/<body>`` for the rest;
-  ``world/<body>/<geom>`` its
+  the world frame: ``world/arm/link2``, ``world/hand/index_distal`` (by the robot's name
+  prefixes), a scene object by its alias (``world/bulb``), ``world/scene/<body>`` for the
+  rest; ``world/<body>/<geom>`` its
   shapes (``world/hand/index_distal/pad``). ``world/contacts/guards/<n>`` where a guard
   stopped an effector (shown for two seconds), ``world/contacts/<set>`` the recorded contact
   points, ``world/fits/<set>`` fitted planes and superquadrics.
@@ -40,14 +39,7 @@ from dial.backend.model import FINGERS, default_profile
 from dial.errors import DialError
 from dial.recording import layout
 from dial.recording.frames import Batch
-from dial.recording.geometry import (
-    Shape,
-    body_paths,
-    moving_bodies,
-    name_groups,
-    shapes,
-    superquadric_mesh,
-)
+from dial.recording.geometry import Shape, body_paths, moving_bodies, shapes, superquadric_mesh
 from dial.recording.lanes import STATE_COLORS, LanePlan, Lanes, Phase
 from dial.recording.styles import (
     EXTENSOR_SHADE,
@@ -176,12 +168,10 @@ class RerunSink:
         self._task = [f"{layout.TASK}/{s.name}" for s in task]
         rec.send_recording_name(title)
         titles = [(s.name, f"{s.label} ({s.unit})") for s in task]
-        tendons = self._profile.hand.load == "tendon"
-        loads = "tendons (N)" if tendons else "joint torques (N m)"
+        loads = "tendons (N)" if self._profile.hand.load == "tendon" else "joint torques (N m)"
         rec.send_blueprint(layout.blueprint(eye, titles, loads))
         rec.log("world", rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
-        arm, hand = self._profile.arm.joints[0], self._profile.fingers[0].joints[0]
-        paths = [f"world/{p}" for p in body_paths(model, objects, name_groups(arm, hand))]
+        paths = [f"world/{p}" for p in body_paths(model, objects, self._profile)]
         moving = set(moving_bodies(model).tolist())
         self._bodies = [paths[b] for b in sorted(moving)]
         for b in range(1, model.nbody):

@@ -22,6 +22,7 @@ from dial.robots.facts import RobotFacts, robot_facts
 from dial.scene.criteria import Criterion, parse_criterion
 from dial.scene.merge import load_merged, read_toml
 from dial.scene.mjcf import body_names
+from dial.scene.objects import Prior, parse_objects
 from dial.scene.reader import Reader, WorldFileError
 from dial.scene.resolve import (
     ROBOT_DIR,
@@ -97,7 +98,8 @@ class Program:
 class World:
     """Everything a world file declares. ``objects`` maps aliases to MuJoCo body names;
     ``robot`` is the folder of the robot the scene binds scripts to (``robot = ...``, by
-    default the Utah hand on the PUMA)."""
+    default the Utah hand on the PUMA); ``priors`` maps body names to what the file says is
+    believed of them (if anything)."""
 
     name: str
     path: Path
@@ -109,6 +111,7 @@ class World:
     criteria: tuple[Criterion, ...]
     thread_turns: float | None = None  # [thread] turns: the model's threads let go after these
     robot: Path = field(default_factory=default_robot)  # the robot's folder (robot.toml)
+    priors: Mapping[str, Prior] = field(default_factory=lambda: MappingProxyType({}))
 
     def scene_names(self) -> SceneNames:
         """The names the script checker needs."""
@@ -137,7 +140,7 @@ def load_world(path: Path) -> World:
     model_path = Path(reader.string(scene["model"], "scene.model"))
     if not model_path.is_file():
         raise reader.error("scene.model", f"no such model file: {model_path}")
-    objects = _objects(reader, data["objects"])
+    objects, priors = parse_objects(reader, data["objects"])
     folder = _robot(reader, data["robot"]) if "robot" in data else default_robot()
     robot = _facts(reader, folder)
     poses: dict[str, HandPose] = {}
@@ -171,6 +174,7 @@ def load_world(path: Path) -> World:
         criteria=criteria,
         thread_turns=_thread_turns(reader, data["thread"]) if "thread" in data else None,
         robot=folder,
+        priors=MappingProxyType(priors),
     )
 
 
@@ -232,16 +236,6 @@ def _shared_poses(world: Reader, path: Path, robot: RobotFacts) -> dict[str, Han
     reader.keys(data, "", ["poses"], [])
     poses = reader.table(data["poses"], "poses")
     return {n: parse_pose(reader, n, t, robot) for n, t in poses.items()}
-
-
-def _objects(reader: Reader, value: Any) -> dict[str, str]:
-    table = reader.table(value, "objects")
-    if not table:
-        raise reader.error("objects", 'declare at least one object (alias = "body_name")')
-    return {
-        _name(reader, "objects", alias): reader.string(body, f"objects.{alias}")
-        for alias, body in table.items()
-    }
 
 
 def _location(reader: Reader, name: str, value: Any, objects: Mapping[str, str]) -> Location:
