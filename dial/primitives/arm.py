@@ -34,6 +34,9 @@ TURN_SPEED = 1.0  # rad/s
 # the IK tolerance (0.5 mm).
 LINE_STEP = 0.004  # m
 LINE_TURN_STEP = np.radians(2.0)  # rad
+# rad: a line's goal this far (any joint) from its last tracked waypoint lies in another arm
+# posture than the one the line tracked
+BASIN_JUMP = 0.1
 
 
 @dataclass(frozen=True)
@@ -117,6 +120,11 @@ class Planner:
         for k in range(1, n):
             u = k / n
             waypoints.append(ik.track(p0 + (p1 - p0) * u, turning(u), waypoints[-1]))
+        if n > 1 and np.abs(q1 - waypoints[-1]).max() > BASIN_JUMP:
+            # A redundant arm's goal, solved from the line's start, can settle on another
+            # posture of the arm (its posture task pulls from afar) than the line tracked:
+            # the line ends in the tracked one, so the arm does not swing at its end.
+            q1 = ik.solve(p1, r1, waypoints[-1], what)
         waypoints.append(q1)
         cost = max(length / LINEAR_SPEED, turn / TURN_SPEED)
         self.segments.append(Segment(np.stack(waypoints), cost))

@@ -9,10 +9,12 @@ import numpy as np
 import pytest
 
 from dial.backend.ik import ArmIK
-from dial.backend.model import ARM_HOME
+from dial.backend.model import ARM_HOME, profile_at
 from dial.geometry import rpy_matrix, slerp
 from dial.primitives.arm import LINE_STEP, Planner
 from dial.primitives.context import Context
+
+from ..conftest import ROOT
 
 
 @pytest.fixture(scope="module")
@@ -41,3 +43,22 @@ def test_the_tool_stays_on_the_line_between_waypoints(ik: ArmIK) -> None:
         worst_rot = max(worst_rot, _angle(rot, slerp(r0, r1, float(u))))
     assert worst_pos < 0.2e-3  # m (measured 0.05 mm; the ends alone would be cm off)
     assert worst_rot < np.radians(0.1)
+
+
+def test_a_redundant_arms_line_ends_in_the_arm_posture_it_tracked() -> None:
+    # allegro_panda's 7-joint arm coming down 100 mm beside containment's rounded solid (the
+    # first side touch of a trial at 10 mm, seed 2680900435): its goal, solved from the
+    # line's start, settled on another posture of the elbow, and the line's last step swung
+    # joints 1 and 3 by 50 deg.
+    profile = profile_at(ROOT / "models" / "allegro_panda")
+    ik = ArmIK(profile=profile)
+    rot = rpy_matrix(np.radians((167.0, 0.0, -90.0)))
+    above, down = np.array([0.4263, -0.1976, 0.6303]), np.array([0.4263, -0.1976, 0.5303])
+    start = np.array([1.042, -0.1777, -1.3955, -2.1886, -0.2654, 1.9269, 2.1461])
+    planner = Planner(cast(Context, SimpleNamespace(arm_ik=ik)), ik.solve(above, rot, start, "x"))
+    planner.line_to(down, rot, "the goal")
+    (seg,) = planner.segments
+    steps = np.abs(np.diff(seg.waypoints, axis=0)).max(axis=1)
+    assert np.degrees(steps.max()) < 5.0, np.degrees(steps).round(1)
+    pos, turned = ik.fk(seg.q1)
+    assert np.linalg.norm(pos - down) < 2e-3 and _angle(turned, rot) < 1e-2
