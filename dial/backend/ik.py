@@ -80,6 +80,7 @@ class ArmIK(_Base):
             orientation_cost=settings.orientation_cost,
         )
         self.tasks: list[mink.Task] = [self.task]
+        self.posture: mink.PostureTask | None = None
         if settings.posture_cost > 0:
             cost = np.zeros(self.model.nv)
             cost[self.index.arm_dof] = settings.posture_cost
@@ -88,6 +89,7 @@ class ArmIK(_Base):
             target[self.index.arm_qpos] = settings.posture
             posture.set_target(target)
             self.tasks.append(posture)
+            self.posture, self.rest = posture, target
         hand = [int(d) for d in self.index.hand_dof]
         self.constraints = [mink.DofFreezingTask(self.model, dof_indices=hand)]
         self.seeds = tuple(np.array(s, dtype=np.float64) for s in settings.seeds)
@@ -104,7 +106,9 @@ class ArmIK(_Base):
         q[self.index.arm_qpos] = arm_q
         self.config.update(q)
 
-    def _iterate(self, pos: FloatArray, rot: FloatArray, iterations: int) -> tuple[float, float]:
+    def _iterate(
+        self, pos: FloatArray, rot: FloatArray, iterations: int, posture: bool = False
+    ) -> tuple[float, float]:
         target = mink.SE3.from_rotation_and_translation(mink.SO3.from_matrix(rot), pos)
         self.task.set_target(target)
         perr = rerr = np.inf
@@ -115,7 +119,7 @@ class ArmIK(_Base):
                 break
             # A posture task (a redundant arm) chooses the basin from afar; near the target
             # it would pull the tool off it, so the last steps are the frame task's alone.
-            near = perr < NEAR * POS_TOL and rerr < NEAR * ROT_TOL
+            near = not posture and perr < NEAR * POS_TOL and rerr < NEAR * ROT_TOL
             vel = mink.solve_ik(
                 self.config,
                 self.tasks[:1] if near else self.tasks,
@@ -129,15 +133,35 @@ class ArmIK(_Base):
         return perr, rerr
 
     def track(
-        self, pos: FloatArray, rot: FloatArray, arm_q: FloatArray, iterations: int = 2
+        self,
+        pos: FloatArray,
+        rot: FloatArray,
+        arm_q: FloatArray,
+        iterations: int = 2,
+        guide: FloatArray | None = None,
     ) -> FloatArray:
-        """A few warm-started steps from ``arm_q`` toward the pose: one waypoint of a line."""
-        key = memo_key(f"{self.MEMO}-track", pos, rot, arm_q, iterations)
+        """A few warm-started steps from ``arm_q`` toward the pose: one waypoint of a line.
+
+        ``guide``: where a redundant arm's spare freedom is drawn (its posture task stays on
+        and aims there, not at the posture): a line's joint interpolation from its start to
+        its goal, so that the spare freedom moves evenly along the line rather than at its
+        end. An arm without a posture task ignores it."""
+        if self.posture is None:
+            guide = None
+        key = memo_key(f"{self.MEMO}-track", pos, rot, arm_q, iterations, guide)
         known = SOLUTIONS.get(key)
         if isinstance(known, np.ndarray):
             return known.copy()
         self._set(arm_q)
-        self._iterate(pos, rot, iterations)
+        if guide is None or self.posture is None:
+            self._iterate(pos, rot, iterations)
+        else:
+            target = self.rest.copy()
+            target[self.index.arm_qpos] = guide
+            self.posture.set_target(target)
+            self._iterate(pos, rot, iterations, posture=True)
+            self.posture.set_target(self.rest)
+            self._iterate(pos, rot, iterations)  # then back onto the line, the frame task alone
         q: FloatArray = self.config.q[self.index.arm_qpos].copy()
         SOLUTIONS.put(key, q.copy())
         return q

@@ -69,10 +69,17 @@ class LeanArmIK(ArmIK):
         return known[:3].copy(), known[3:].reshape(3, 3).copy()
 
     def track(
-        self, pos: FloatArray, rot: FloatArray, arm_q: FloatArray, iterations: int = 2
+        self,
+        pos: FloatArray,
+        rot: FloatArray,
+        arm_q: FloatArray,
+        iterations: int = 2,
+        guide: FloatArray | None = None,
     ) -> FloatArray:
         """:meth:`ArmIK.track` without the memo: the planner keeps a line whole, and no
         waypoint is asked for twice otherwise (the memo's bookkeeping was all cost)."""
+        if guide is not None and self.posture is not None:  # a redundant arm: mink's QP
+            return super().track(pos, rot, arm_q, iterations, guide)
         self._set(arm_q)
         self._iterate(pos, rot, iterations)
         q: FloatArray = self.config.data.qpos[self._qpos].copy()
@@ -84,9 +91,11 @@ class LeanArmIK(ArmIK):
             data.qpos[self._qpos] = arm_q
             self.config.update()
 
-    def _iterate(self, pos: FloatArray, rot: FloatArray, iterations: int) -> tuple[float, float]:
+    def _iterate(
+        self, pos: FloatArray, rot: FloatArray, iterations: int, posture: bool = False
+    ) -> tuple[float, float]:
         if len(self.tasks) > 1:  # a posture task (a redundant arm): mink's QP as it is
-            return super()._iterate(pos, rot, iterations)
+            return super()._iterate(pos, rot, iterations, posture)
         task, config = self.task, self.config
         target = np.empty(7)
         mujoco.mju_mat2Quat(target[:4], np.ascontiguousarray(rot, dtype=np.float64).ravel())

@@ -34,9 +34,6 @@ TURN_SPEED = 1.0  # rad/s
 # the IK tolerance (0.5 mm).
 LINE_STEP = 0.004  # m
 LINE_TURN_STEP = np.radians(2.0)  # rad
-# rad: a line's goal this far (any joint) from its last tracked waypoint lies in another arm
-# posture than the one the line tracked
-BASIN_JUMP = 0.1
 
 
 @dataclass(frozen=True)
@@ -117,14 +114,14 @@ class Planner:
         turn = float(np.arccos(np.clip((np.trace(r0.T @ r1) - 1.0) / 2.0, -1.0, 1.0)))
         n = max(1, math.ceil(max(length / LINE_STEP, turn / LINE_TURN_STEP)))
         waypoints, turning = [self.q], Slerp(r0, r1)
+        q0 = self.q
         for k in range(1, n):
             u = k / n
-            waypoints.append(ik.track(p0 + (p1 - p0) * u, turning(u), waypoints[-1]))
-        if n > 1 and np.abs(q1 - waypoints[-1]).max() > BASIN_JUMP:
-            # A redundant arm's goal, solved from the line's start, can settle on another
-            # posture of the arm (its posture task pulls from afar) than the line tracked:
-            # the line ends in the tracked one, so the arm does not swing at its end.
-            q1 = ik.solve(p1, r1, waypoints[-1], what)
+            # A redundant arm's goal, solved from afar, may hold its spare freedom elsewhere
+            # than the start (its posture task): the waypoints are drawn to the joints'
+            # interpolation, so that it moves evenly along the line, not in its last step.
+            guide = q0 + (q1 - q0) * u
+            waypoints.append(ik.track(p0 + (p1 - p0) * u, turning(u), waypoints[-1], guide=guide))
         waypoints.append(q1)
         cost = max(length / LINEAR_SPEED, turn / TURN_SPEED)
         self.segments.append(Segment(np.stack(waypoints), cost))

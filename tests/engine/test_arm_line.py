@@ -47,9 +47,10 @@ def test_the_tool_stays_on_the_line_between_waypoints(ik: ArmIK) -> None:
 
 def test_a_redundant_arms_line_ends_in_the_arm_posture_it_tracked() -> None:
     # allegro_panda's 7-joint arm coming down 100 mm beside containment's rounded solid (the
-    # first side touch of a trial at 10 mm, seed 2680900435): its goal, solved from the
-    # line's start, settled on another posture of the elbow, and the line's last step swung
-    # joints 1 and 3 by 50 deg.
+    # first side touch of a trial at 10 mm, seed 2680900435): its goal, solved from afar,
+    # holds the elbow 50 deg from where the line starts, and the line's last step swung
+    # joints 1 and 3 that far. Drawn to the joints' interpolation, the waypoints move the
+    # elbow evenly, a few degrees a step, and stay within a millimetre of the line.
     profile = profile_at(ROOT / "models" / "allegro_panda")
     ik = ArmIK(profile=profile)
     rot = rpy_matrix(np.radians((167.0, 0.0, -90.0)))
@@ -60,5 +61,9 @@ def test_a_redundant_arms_line_ends_in_the_arm_posture_it_tracked() -> None:
     (seg,) = planner.segments
     steps = np.abs(np.diff(seg.waypoints, axis=0)).max(axis=1)
     assert np.degrees(steps.max()) < 5.0, np.degrees(steps).round(1)
-    pos, turned = ik.fk(seg.q1)
-    assert np.linalg.norm(pos - down) < 2e-3 and _angle(turned, rot) < 1e-2
+    worst_pos = worst_rot = 0.0
+    for u in np.linspace(0.0, 1.0, 201):
+        pos, turned = ik.fk(seg.at(float(u)))
+        worst_pos = max(worst_pos, float(np.linalg.norm(pos - (above + (down - above) * u))))
+        worst_rot = max(worst_rot, _angle(turned, rot))
+    assert worst_pos < 1.5e-3 and worst_rot < np.radians(0.5)  # measured 0.84 mm, 0.28 deg
