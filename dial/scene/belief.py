@@ -50,6 +50,10 @@ class Feeling:
 # fraction of their extent from it (a solid touched all round, or on its top and at its bottom
 # edge; not one touched from one side, or from the top down to below its middle only).
 AROUND = 0.1
+# ... and they touch both of its ends along the axis: on each side, a contact that lies further
+# out along the axis than this fraction of its distance from the centre along any other axis
+# (a point on the face or cap facing that way, not on a side that curves in towards it).
+FACING = 0.8
 
 
 @dataclass(frozen=True)
@@ -208,10 +212,12 @@ class Beliefs:
     ) -> None:
         """The fitted superquadric is the object: its size the fitted half-sizes, each taken
         along the body axis closest to the fitted axis, and its origin at the fitted centre
-        along each body axis on which the contacts ``points`` (N, 3) lie around that centre:
-        their midrange along the axis within ``AROUND`` of their extent from it. Along an axis
-        on which they do not (the bottom of a solid on its stand is never touched, so along
-        the vertical the contacts run from the top to the bottom edge only), the fit closes
+        along each body axis on which the contacts ``points`` (N, 3) lie around that centre
+        (their midrange along the axis within ``AROUND`` of their extent from it) and touch
+        both its ends (:func:`_ends_touched`). Along an axis on which they do not (the bottom
+        of a solid on its stand is never touched: along the vertical the contacts run from
+        the top down to the bottom edge, or only to the middle of an ellipsoid, whose first
+        fit, on a few contacts, may come out flat and centred between them), the fit closes
         the shape by its own assumptions, and the believed position along it stays. The
         believed orientation is kept: a symmetric solid's fitted axes are ambiguous (a
         cylinder's about its own axis), and the fits measure where an object is and how
@@ -223,7 +229,7 @@ class Beliefs:
         along = (np.asarray(points, dtype=np.float64) - centre) @ rot  # body axes
         low, high = along.min(axis=0), along.max(axis=0)
         around = np.abs(low + high) / 2.0 <= AROUND * (high - low)
-        new = pos + rot @ np.where(around, rot.T @ (centre - pos), 0.0)
+        new = pos + rot @ np.where(around & _ends_touched(along), rot.T @ (centre - pos), 0.0)
         size = half[_closest(rot, axes)]
         self.set(body, (new, rot), t, "fit_superquadric", size, name)
 
@@ -244,6 +250,20 @@ class Beliefs:
         for k in range(2):
             size[int(np.argmax(np.abs(rot.T @ axes[k])))] = extents[k] / 2.0
         self.set(body, (new, rot), t, "fit_plane", size, name)
+
+
+def _ends_touched(along: FloatArray) -> FloatArray:
+    """For each axis, whether the contacts ``along`` (N, 3; from the fitted centre, along the
+    body axes) touch both its ends: on each side a contact within the cone of ``FACING``
+    about the axis. A solid touched on its top and round its middle, never underneath, is not
+    touched at its bottom end: however its fit closes the shape below, the contacts do not
+    say where its centre is along the vertical."""
+    out = np.zeros(3, dtype=bool)
+    for k in range(3):
+        other = np.abs(np.delete(along, k, axis=1)).max(axis=1)
+        end = np.abs(along[:, k]) >= FACING * other
+        out[k] = bool((end & (along[:, k] > 0)).any() and (end & (along[:, k] < 0)).any())
+    return out
 
 
 def _vector(value: object) -> FloatArray:

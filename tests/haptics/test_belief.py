@@ -112,6 +112,26 @@ def test_a_superquadric_places_the_object_where_its_contacts_surround_it() -> No
     assert records[-1]["object"] == "target" and records[-1]["why"] == "fit_superquadric"
 
 
+def test_a_fit_centred_between_the_top_and_the_middle_does_not_move_the_height() -> None:
+    """An ellipsoid touched on its top (+30 mm) and round its middle (0 to -4 mm), never
+    underneath: a first fit on these few contacts came out flat (half-height 17 mm) and
+    centred 12 mm high, between them, so the contacts lie around its centre; but none of them
+    is at its bottom end, and the height stays as believed (seed 4094713144 of issue 27)."""
+    world = load_world(WORLDS / "containment_rounded.toml")
+    beliefs, _ = _beliefs(world)
+    body = world.objects["target"]
+    truth = np.array([0.40, -0.22, 0.50])
+    angles = np.radians(np.arange(0.0, 360.0, 90.0))
+    ring = np.stack([np.cos(angles) * 0.04, np.sin(angles) * 0.035, -0.004 + 0 * angles], 1)
+    middle = np.stack([np.cos(angles) * 0.04, np.sin(angles) * 0.035, 0 * angles], 1)
+    points = truth + np.vstack([ring, middle, [(0, 0, 0.03)]])
+    fit = {"centre": list(truth + np.array([0.0, 0.0, 0.0125])), "rotation": np.eye(3).tolist(),
+           "size": [0.043, 0.035, 0.017]}  # fmt: skip
+    beliefs.learn_superquadric(body, fit, points, 5.0, "target")
+    pos, _ = beliefs.poses[body]
+    assert np.allclose(pos, [0.40, -0.22, 0.4])  # x, y learned; the height kept (0.4)
+
+
 def test_a_plane_moves_the_object_in_the_plane_and_sizes_it_there() -> None:
     world = load_world(WORLDS / "surface.toml")
     beliefs, records = _beliefs(world)
