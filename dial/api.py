@@ -136,7 +136,7 @@ def run(
     stop signal (SIGINT, SIGTERM) ends the run cleanly: ``result.summary.interrupted``.
     """
     items, saved = _checked(tick, speed, seed, perturb, disturb, save_at, resume)
-    _check_watching(record, video, rerun, viewer)  # before the script: usage comes first
+    check_watching(record, video, rerun, viewer)  # before the script: usage comes first
     script = _script(script, scene)
     from dial.engine import RunOptions
     from dial.engine import run as run_engine
@@ -215,7 +215,7 @@ def _event_names(script: Script) -> set[str]:
     return {name for called in scripts_of(script) for name in called.events}
 
 
-def _check_watching(
+def check_watching(
     record: str | Path | None, video: str | Path | None, rerun: bool, viewer: bool
 ) -> None:
     """What can be known about ``record``, ``video``, ``rerun`` and ``viewer`` before a run."""

@@ -207,20 +207,27 @@ def check_remote(args: argparse.Namespace) -> None:
         "--save-at": args.save_at,
         "--resume": args.resume,
         "--realtime": args.realtime,
-        "--record": args.record,  # not yet: the predicted and the reported robot together
-        "--rerun": args.rerun,
     }
     given = [flag for flag, value in local.items() if value]
     if given:
         raise UsageError(
             f"{', '.join(given)}: not with --remote (the robot's world is perturbed and "
-            "disturbed at 'dial serve'; a remote run is paced by the robot; a recording of "
-            "the predicted and the reported robot together is not done yet)"
+            "disturbed at 'dial serve'; a remote run is paced by the robot)"
         )
+    if (args.record or args.rerun) and args.no_predict:
+        raise UsageError(
+            "--record and --rerun draw the prediction beside the robot: not with --no-predict"
+        )
+    if args.record or args.rerun:
+        from dial.api import check_watching
+
+        check_watching(args.record, None, args.rerun, False)
     if args.link is not None:
         from dial.remote.link import parse_link  # a usage error before anything connects
 
         parse_link(args.link)
+    if args.lead is not None and args.split != "block":
+        raise UsageError("--lead: only with --split block (how far ahead a block is tagged)")
     if args.lead is not None and not (math.isfinite(args.lead) and args.lead > 0):
         raise UsageError(f"--lead must be above 0 s, got {args.lead:g}")
     if not (math.isfinite(args.diverge) and args.diverge > 0):

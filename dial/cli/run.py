@@ -71,7 +71,8 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         "--record",
         metavar="FILE.rrd",
         help="write a rerun recording: geometry, body poses, joints, tendons, tactile "
-        "images, event lanes (open with 'rerun FILE.rrd'; see docs/recording.md)",
+        "images, event lanes (open with 'rerun FILE.rrd'; see docs/recording.md); with "
+        "--remote, the predicted robot and the reported one together",
     )
     p.add_argument(
         "--video",
