@@ -57,6 +57,7 @@ class Channel:
     seq: int = 0
     sent_bytes: int = 0
     received_bytes: int = 0
+    telemetry: int = 0  # samples received
     rtt: float | None = None
     lost: str | None = None
     done: bool = False  # the session is over: stop reconnecting
@@ -142,6 +143,7 @@ class Channel:
         elif kind == "pong":
             self._pong.set()
         elif kind == "telemetry":
+            self.telemetry += 1
             self.on_telemetry(msg)
         elif kind == "error":
             self.link_record("error", code=msg.text("code"), message=msg.text("message"))

@@ -235,6 +235,7 @@ def summary_record(op: Operator, wall: float) -> Record:
         "session": ch.session,
         "sent_bytes": ch.sent_bytes,
         "received_bytes": ch.received_bytes,
+        "telemetry": ch.telemetry,
         "rtt": None if ch.rtt is None else round(ch.rtt, 3),
         "link": None if op.options.link is None else op.options.link.text(),
         "lead": next((r.get("seconds") for r in op.out.log.of("lead")), None),
