@@ -114,7 +114,12 @@ def add_run_options(p: argparse.ArgumentParser) -> None:
         "the log adds link records (sent, acknowledged, reported, late, lost, diverged).",
     )
     g.add_argument("--remote", metavar="URL", help="the robot's server, ws://HOST:PORT")
-    g.add_argument("--token-file", metavar="F", help="the robot's token file")
+    g.add_argument(
+        "--token-file",
+        metavar="F",
+        help="the robot's token file, as 'dial serve' wrote it (default: "
+        "$XDG_STATE_HOME/dial/token, that is ~/.local/state/dial/token)",
+    )
     g.add_argument(
         "--split",
         choices=("script", "block"),
@@ -123,14 +128,19 @@ def add_run_options(p: argparse.ArgumentParser) -> None:
         "here and send each block tagged with its start tick",
     )
     g.add_argument(
-        "--link", metavar="SPEC", help="emulate a link: 'delay=1s jitter=100ms bandwidth=...'"
+        "--link",
+        metavar="SPEC",
+        help="emulate a link on the way: 'delay=2s jitter=300ms bandwidth=2400bps cut=T:D "
+        "blackhole=T seed=N' (any of them; as 'dial link')",
     )
     g.add_argument(
         "--lead",
         type=float,
         metavar="S",
         help="--split block: tag a block that waited for a report S s of robot time ahead "
-        "(default: 1.5 round trips measured at connect, and 0.2 s)",
+        "(default: 1.5 round trips and 0.2 s; the round trip is --link's worst, else the one "
+        "measured at connect, and then the lead is rounded up to 0.5, 1, 2, 4... s; the "
+        "operator says which)",
     )
     g.add_argument(
         "--diverge",
@@ -141,7 +151,10 @@ def add_run_options(p: argparse.ArgumentParser) -> None:
         "prediction (default 10)",
     )
     g.add_argument(
-        "--no-predict", action="store_true", help="do not run the prediction on this side"
+        "--no-predict",
+        action="store_true",
+        help="do not predict the robot on this side (no 'diverged' records; --record and "
+        "--rerun draw the prediction, so they need it)",
     )
 
 
