@@ -319,3 +319,18 @@ def test_the_token_file_is_written_beside_the_log_or_in_the_state_folder(
     from dial.cli import build_parser
 
     assert build_parser().parse_args(["serve"]).listen == "127.0.0.1:8765"
+
+
+def test_an_upload_that_does_not_check_in_the_robots_world_is_rejected_before_anything_moves(
+    tmp_path: Path,
+) -> None:
+    """The robot checks an uploaded script against its own world (here --scene reactions,
+    where pour's programs and poses do not exist): every diagnostic goes back, with its
+    caret, and the scene is never set up."""
+    with server(tmp_path, "--scene", "reactions", pace=PACE) as srv:
+        code, summary, err = run_operator(srv, "pour.dial", "--no-predict")
+        assert _status(srv)["state"] == "rejected"
+        records = srv.records()
+    assert code == 1 and summary is not None and summary["ok"] is False
+    assert "unknown program 'get_top' in scene 'reactions'" in err and "^" in err
+    assert not any(r["kind"] in ("scene", "start") for r in records)
