@@ -197,6 +197,26 @@ def cmd_link(args: argparse.Namespace) -> int:
     return run_link(host, port, args.to, parse_link(args.spec))
 
 
+# ``dial run`` options a remote run does not take: (dest, flag, why).
+WORLD = "the robot's world is perturbed and disturbed at 'dial serve'"
+PACED = "a remote run is paced by the robot: it does not pause, save or resume"
+SEEN = "the operator sees the robot in decimated telemetry: frames are a local run's"
+LOCAL_ONLY = (
+    ("perturb", "--perturb", WORLD),
+    ("seed", "--seed", WORLD),
+    ("disturb", "--disturb", WORLD),
+    ("breaks", "--break", PACED),
+    ("step", "--step", PACED),
+    ("save_at", "--save-at", PACED),
+    ("resume", "--resume", PACED),
+    ("realtime", "--realtime", PACED),
+    ("video", "--video", SEEN),
+    ("viewer", "--viewer", SEEN),
+    ("log_states", "--log-states", SEEN),
+    ("dataset", "--dataset", SEEN),
+)
+
+
 def check_remote(args: argparse.Namespace) -> None:
     """Usage errors of ``dial run --remote`` (what only the robot, or only a local run, has)."""
     if args.remote is None:
@@ -208,25 +228,10 @@ def check_remote(args: argparse.Namespace) -> None:
         return
     if not args.remote.startswith(("ws://", "wss://")):
         raise UsageError(f"--remote: expected ws://HOST:PORT, got '{args.remote}'")
-    local = {
-        "--perturb": args.perturb,
-        "--seed": args.seed,
-        "--disturb": args.disturb,
-        "--video": args.video,
-        "--viewer": args.viewer,
-        "--log-states": args.log_states,
-        "--break": args.breaks,
-        "--step": args.step,
-        "--save-at": args.save_at,
-        "--resume": args.resume,
-        "--realtime": args.realtime,
-    }
-    given = [flag for flag, value in local.items() if value]
+    given = [flag for dest, flag, _ in LOCAL_ONLY if getattr(args, dest)]
     if given:
-        raise UsageError(
-            f"{', '.join(given)}: not with --remote (the robot's world is perturbed and "
-            "disturbed at 'dial serve'; a remote run is paced by the robot)"
-        )
+        why = dict.fromkeys(why for dest, _, why in LOCAL_ONLY if getattr(args, dest))
+        raise UsageError(f"{', '.join(given)}: not with --remote ({'; '.join(why)})")
     if (args.record or args.rerun) and args.no_predict:
         raise UsageError(
             "--record and --rerun draw the prediction beside the robot: not with --no-predict"
