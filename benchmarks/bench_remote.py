@@ -49,6 +49,7 @@ def bench(script: str, pace: float, delays: list[float], folder: Path) -> list[s
     local = _json(_dial("run", script, "--quiet", "--json"))
     task = float(str(local["sim_time"]))
     rows = [f"{script:<16} local {task:7.2f} s (simulated time)"]
+    print(rows[0], flush=True)
     server = subprocess.Popen(
         _dial(
             "serve",

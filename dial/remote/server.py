@@ -134,6 +134,9 @@ class Server:
             self.conns.discard(conn)
             if self.controller is conn:
                 self.controller = None  # the session waits for its operator: the watchdog runs
+                s = conn.session
+                if s is not None and s.active:  # a cut, a dead operator: said in the log
+                    s.link_record("disconnected", session=s.number, tick=s.tick)
             with trio.CancelScope(shield=True), trio.move_on_after(CLOSE_S):
                 await conn.ws.aclose()
 

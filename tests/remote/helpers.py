@@ -26,24 +26,11 @@ from contextlib import contextmanager, suppress
 from pathlib import Path
 from typing import IO
 
+from dial.remote.session import LINK_RECORDS
+
 ROOT = Path(__file__).resolve().parents[2]
 START_S = 90.0  # a process must say where it listens within this (a loaded machine)
 WAIT_S = 150.0  # no operator in these tests runs longer
-LINK_KINDS = {
-    "session",
-    "received",
-    "sent",
-    "acknowledged",
-    "reported",
-    "late",
-    "lost",
-    "diverged",
-    "connected",
-    "rtt",
-    "lead",
-    "refused",
-    "error",
-}
 # Sets PR_SET_PDEATHSIG (SIGKILL) and becomes the command: it dies with the test process.
 _LAUNCH = (
     "import ctypes, os, sys; ctypes.CDLL(None, use_errno=True).prctl(1, 9, 0, 0, 0); "
@@ -254,7 +241,7 @@ def robot_log(records: list[dict[str, object]], session: int = 1) -> list[dict[s
     for r in records:
         if r["kind"] == "session":
             current = int(str(r["session"]))
-        if current != session or r["kind"] in LINK_KINDS:
+        if current != session or r["kind"] in LINK_RECORDS:
             continue
         out.append({k: v for k, v in r.items() if k not in ("wall_time", "wall")})
     return out

@@ -4,6 +4,7 @@ without ``--lead``, a cut in the middle of a block, prediction, and ``--record``
 
 from __future__ import annotations
 
+import json
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from contextlib import ExitStack
@@ -12,9 +13,21 @@ from typing import Any
 
 from rerun.chunk import Chunk, RrdReader
 
-from tests.remote.helpers import link, read_log, robot_log, run_dial, run_operator, server
+from tests.remote.cutter import cutter
+from tests.remote.helpers import (
+    Server,
+    link,
+    operator,
+    read_log,
+    robot_log,
+    run_dial,
+    run_operator,
+    server,
+    wait_for,
+)
 
 PERTURBED = ("--perturb", "10", "--seed", "3")
+BLOCK = ("--split", "block")
 
 
 def _parallel(*jobs: Callable[[], Any]) -> list[Any]:
@@ -145,33 +158,48 @@ def _recorded(rrd: Path, op: list[dict[str, object]]) -> None:
     assert ["running"] in states and [str(ended[0]["outcome"])] in states
 
 
+def _into_block(srv: Server, ticks: int) -> bool:
+    """The robot has run ``ticks`` ticks of its first block (and not yet finished it)."""
+    kinds = [(r["kind"], r.get("tick")) for r in srv.records()]
+    begun = [tick for kind, tick in kinds if kind == "block"]
+    ended = any(kind in ("condition", "idle") for kind, _ in kinds)
+    return bool(begun) and not ended and ("tick", int(str(begun[0])) + ticks) in kinds
+
+
 def test_a_cut_in_a_block_is_followed_by_a_reconnect_and_each_block_runs_once(
     tmp_path: Path,
 ) -> None:
-    """A 3 s cut while pour's blocks run (watchdog 6 s): the operator reconnects, sends
-    what was not acknowledged again, and the robot runs each command once."""
-    with server(tmp_path, "--watchdog", "6", pace=0.2) as srv:
-        code, summary, err = run_operator(
-            srv,
-            "pour.dial",
-            "--split",
-            "block",
-            "--link",
-            "delay=0.05s cut=2.5:3",
-            "--no-predict",
-            log=tmp_path / "op.jsonl",
-        )
+    """The link drops for 3 s while pour's first block (13 ticks) runs at the robot, with
+    --split block (through a relay that the test cuts 4 ticks into the block; watchdog
+    6 s): the block runs on, the operator reconnects and sends again what was not
+    acknowledged, the robot runs each command and each block once, and the run succeeds
+    (through the link emulation's own cut, too: --link "delay=0.05s cut=...")."""
+    log = tmp_path / "op.jsonl"
+    with (
+        server(tmp_path, "--watchdog", "6", pace=0.5) as srv,
+        cutter(srv.url) as relay,
+        operator(srv, "pour.dial", *BLOCK, "--no-predict", log=log, url=relay.url) as op,
+    ):
+        assert wait_for(lambda: _into_block(srv, 4), 90), srv.records()[-3:]
+        relay.cut(3.0)
+        out, err = op.communicate(timeout=150)
         records = srv.records()
-    assert code == 0, err
-    assert summary is not None and summary["ok"] is True
-    sessions = [r for r in records if r["kind"] == "session"]
-    assert [s["resumed"] for s in sessions][:2] == [False, True]  # a reconnect happened
+    assert op.returncode == 0, err
+    summary = json.loads(out.strip().splitlines()[-1])
+    assert summary["ok"] is True
+    kinds = [r["kind"] for r in records]
+    cut, back = kinds.index("disconnected"), kinds.index("session", 1)
+    assert records[back]["resumed"] is True  # a reconnect to the same session
+    assert 3.0 <= float(records[back]["wall"]) - float(records[cut]["wall"]) < 6.0
+    # The cut came in the middle of block 1, which ran on through it at the robot.
+    assert kinds[:cut].count("block") == 1 and "condition" not in kinds[:cut]
+    assert "tick" in kinds[cut : kinds.index("condition")]
     received = [r["seq"] for r in records if r["kind"] == "received"]
-    assert len(received) == len(set(received))
-    blocks = [r["number"] for r in robot_log(records) if r["kind"] == "block"]
-    assert blocks == list(range(1, len(blocks) + 1))
-    op = read_log(tmp_path / "op.jsonl")
-    ticks = [r["tick"] for r in op if r["kind"] == "tick"]
+    assert len(received) == len(set(received))  # no command received twice
+    blocks = [(r["number"], r["line"]) for r in robot_log(records) if r["kind"] == "block"]
+    assert [n for n, _ in blocks] == list(range(1, len(blocks) + 1))  # each block once
+    assert blocks[0][1] == 75 and [line for _, line in blocks].count(75) == 1
+    ticks = [r["tick"] for r in read_log(log) if r["kind"] == "tick"]
     assert ticks == sorted(set(ticks))  # every record reported once, in order
 
 

@@ -19,6 +19,7 @@ from typing import Any
 
 import pytest
 
+from dial import load as dial_load
 from dial.remote.telemetry import telemetry_every
 from tests.remote.helpers import (
     Server,
@@ -198,9 +199,19 @@ def test_bad_input_gets_the_documented_errors_and_the_server_keeps_serving(
     """A wrong token runs nothing; malformed JSON, a 10 MB frame, an unknown type, a wrong
     version each get their error and the connection stays; a second operator is refused;
     a good session afterwards succeeds, through a slow link: its telemetry decimated."""
-    with websockets.connect(robot.url) as ws:  # a wrong token: refused, closed
+    from dial.remote.walk import upload
+
+    before = robot.records()
+    with websockets.connect(robot.url) as ws:  # a wrong token: refused, closed, nothing runs
         _send(ws, "hello", token="nope", role="operator")
+        script = upload(dial_load("reactions.dial"))
+        with contextlib.suppress(closed):  # (sent at once, on a connection being closed)
+            _send(ws, "run", seq=1, id="c1", tick=1, after=0, script=script, tick_length=0.1)
         assert _recv(ws)["code"] == "token"
+        with pytest.raises(closed):
+            for _ in range(100):
+                ws.recv(timeout=5)
+    assert robot.records() == before  # no session, no scene, no run
     with websockets.connect(robot.url, max_size=None) as ws:
         _send(ws, "status")
         assert _recv(ws)["code"] == "order"  # hello first
