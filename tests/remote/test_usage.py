@@ -4,6 +4,7 @@ not take are one-line usage errors (exit 2) before anything connects (no server 
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
 import pytest
 
@@ -79,3 +80,36 @@ def test_what_a_remote_run_does_not_take_is_a_usage_error(
 def test_remote_options_need_remote(flag: list[str], capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["run", "pour.dial", *flag]) == 2
     assert f"{flag[0]} needs --remote URL" in capsys.readouterr().err
+
+
+DOC = (Path(__file__).resolve().parents[2] / "docs" / "remote.md").read_text(encoding="utf-8")
+
+
+def test_the_protocol_doc_names_every_message_error_and_refusal() -> None:
+    """docs/remote.md is what a client of another library follows (test_safety.py's
+    websockets client): every message type each way, every error and refusal code."""
+    from dial.remote.protocol import ERRORS, TO_OPERATOR, TO_ROBOT, VERSION
+
+    assert f"version {VERSION}" in DOC
+    to_robot = DOC.split("### To the robot")[1].split("### To the operator")[0]
+    to_operator = DOC.split("### To the operator")[1].split("### Errors")[0]
+    for types, text in ((TO_ROBOT, to_robot), (TO_OPERATOR, to_operator)):
+        for name, fields in types.items():
+            row = next((r for r in text.splitlines() if r.startswith(f"| `{name}` |")), None)
+            assert row is not None, name
+            for field_name in fields:
+                assert f"`{field_name.rstrip('?')}`" in row, (name, field_name)
+    for code in (*ERRORS, "rejected", "late", "dropped", "mismatch"):
+        assert f"`{code}`" in DOC, code
+
+
+def test_the_benchmark_table_is_in_the_doc() -> None:
+    """Pour and the light bulb, both splits, delays 0, 0.5, 2 and 7 s, with the ratio to
+    the local run and the bytes each way (benchmarks/bench_remote.py's columns)."""
+    rows = {tuple(c.strip() for c in r.strip("|").split("|")) for r in DOC.splitlines()}
+    for script in ("pour", "light bulb"):
+        for split in ("script", "block"):
+            for delay in ("0 s", "0.5 s", "2 s", "7 s"):
+                row = next((r for r in rows if r[:3] == (script, split, delay)), None)
+                assert row is not None and len(row) == 8, (script, split, delay)
+                assert row[4].endswith("x") and row[6].isdigit() and row[7].isdigit(), row
