@@ -179,7 +179,7 @@ def test_a_cut_in_a_block_is_followed_by_a_reconnect_and_each_block_runs_once(
     (through the link emulation's own cut, too: --link "delay=0.05s cut=...")."""
     log = tmp_path / "op.jsonl"
     with (
-        server(tmp_path, "--watchdog", "6", pace=0.5) as srv,
+        server(tmp_path, "--watchdog", "6", pace=0.3) as srv,
         cutter(srv.url) as relay,
         operator(srv, "pour.dial", *BLOCK, "--no-predict", log=log, url=relay.url) as op,
     ):
