@@ -111,7 +111,10 @@ def add_run_options(p: argparse.ArgumentParser) -> None:
     g = p.add_argument_group(
         "remote robot (docs/remote.md)",
         "Run at a robot served by 'dial serve': the summary and criteria are the robot's, "
-        "the log adds link records (sent, acknowledged, reported, late, lost, diverged).",
+        "the log adds link records (sent, acknowledged, reported, late, lost, diverged). "
+        "The robot's world (--perturb, --seed, --disturb) is set at 'dial serve'; with "
+        "--remote those, the debugging options, --realtime, --video, --viewer, "
+        "--log-states and --dataset are usage errors.",
     )
     g.add_argument("--remote", metavar="URL", help="the robot's server, ws://HOST:PORT")
     g.add_argument(
