@@ -7,6 +7,7 @@ Exit status: 0 success, 1 a script or run error (or a failed criterion), 2 a usa
 from __future__ import annotations
 
 import argparse
+import os
 import signal
 import sys
 from collections.abc import Sequence
@@ -55,8 +56,16 @@ def main(argv: Sequence[str] | None = None) -> int:
     return status
 
 
+# The options that draw with MuJoCo (offscreen or in a window).
+_DRAWING = ("video", "viewer", "snapshot", "picture", "storyboard")
+
+
 def _main(argv: Sequence[str] | None) -> int:
     args = build_parser().parse_args(argv)
+    if argv is None and not any(getattr(args, name, None) for name in _DRAWING):
+        # Nothing is drawn: MuJoCo need not look for an OpenGL library when it loads (on
+        # Linux its GLFW binding starts a Python process per library it finds, 0.1 s).
+        os.environ.setdefault("MUJOCO_GL", "disable")
     try:
         status: int = args.func(args)
     except ScriptError as e:

@@ -9,16 +9,20 @@ import sys
 from collections.abc import Iterator
 from contextlib import contextmanager
 from types import FrameType
+from typing import TYPE_CHECKING
 
-from dial.api import load
 from dial.errors import OptionError
-from dial.parser.script import Script
+
+if TYPE_CHECKING:
+    from dial.parser.script import Script
 
 UsageError = OptionError  # a usage problem: exit status 2
 
 
 def load_script(arg: str, scene: str | None) -> Script:
     """A script argument (a path, else a bundled name), checked against ``--scene``."""
+    from dial.api import load  # the parser: not for --help
+
     return load(arg, scene=scene)
 
 

@@ -8,13 +8,11 @@ import sys
 from collections.abc import Callable
 from typing import TYPE_CHECKING
 
-from dial import api
 from dial.cli.common import UsageError, load_script, scene_argument
-from dial.recording.timeline import qualified_event
-from dial.scheduler.signals import EXIT_STATUS, StopRequest, catch_stop_signals
 
-if TYPE_CHECKING:
+if TYPE_CHECKING:  # what a run needs loads when it runs: `dial --help` stays quick
     from dial.engine import RunResult
+    from dial.scheduler.signals import StopRequest
 
 DESCRIPTION = (
     "Run a script on the simulated hand and arm. Shows live progress, then each event's "
@@ -116,12 +114,17 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
 def cmd_run(args: argparse.Namespace) -> int:
     # From here to the exit, a stop signal stops the run (which catches it first) or, once
     # the run is over, is ignored: a second Ctrl-C cannot cut the summary or the log short.
+    from dial.scheduler.signals import StopRequest, catch_stop_signals
+
     stop = StopRequest()
     with catch_stop_signals(stop):
         return _run(args, stop)
 
 
 def _run(args: argparse.Namespace, stop: StopRequest) -> int:
+    from dial import api
+    from dial.scheduler.signals import EXIT_STATUS
+
     if args.log_states and not args.log:
         raise UsageError("--log-states writes into the log: give --log FILE.jsonl too")
     api.check_options(args.tick, args.speed, args.seed, args.perturb)
@@ -207,6 +210,8 @@ def _progress(quiet: bool) -> Callable[[int, float, list[str]], None] | None:
 
 def summary_text(result: RunResult) -> str:
     """The table ``dial run`` prints: each run's end, the times, the criteria (pure)."""
+    from dial.recording.timeline import qualified_event
+
     s = result.summary
     lines = [f"scene {result.world.name}: {s.ticks} ticks of {s.tick_length:g} s"]
     ends = result.log.of("end")

@@ -5,10 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from dial import api
 from dial.cli.common import UsageError, at_least, scene_argument, sigterm_as_interrupt
-from dial.disturb import parse_disturbance
-from dial.instructions.scene_names import SceneNotFoundError
 
 
 def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
@@ -72,6 +69,9 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
 
 
 def cmd_tune(args: argparse.Namespace) -> int:
+    from dial import api
+    from dial.disturb import parse_disturbance
+    from dial.instructions.scene_names import SceneNotFoundError
     from dial.scene.resolve import scene_option
     from dial.tune import ProcessExecutor, TuneOptions, models, parse_ticks, tune
 

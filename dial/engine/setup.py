@@ -13,7 +13,7 @@ import numpy as np
 
 from dial.backend.disturb import Disturbances
 from dial.backend.driver import MujocoRobot
-from dial.backend.ik import ArmIK
+from dial.backend.ik import ArmIK, FingerIK
 from dial.backend.model import ARM_HOME, RobotIndex, hand_ctrl, load_model
 from dial.disturb import Disturbance
 from dial.geometry import Pose, location_pose, rpy_matrix
@@ -104,4 +104,4 @@ def prepare(
     where = world.path.name if bundled else str(world.path)
     log.write("scene", scene=world.name, world=where, perturb=shift, seed=seed)
     robot = MujocoRobot(model, data, disturbances=placed)
-    return robot, Context(robot, world, believed, ik)
+    return robot, Context(robot, world, believed, ik, FingerIK(ik.model))  # one IK model

@@ -15,7 +15,7 @@ from dataclasses import dataclass, field, replace
 from difflib import get_close_matches
 from pathlib import Path
 
-from dial.errors import Diagnostic, ScriptError, Span
+from dial.errors import MAX_PROBLEMS, Cutoff, Diagnostic, ScriptError, Span, TooManyProblems
 from dial.instructions.catalogue import INSTRUCTIONS, Instruction
 from dial.instructions.scene_names import SceneLoader, SceneNames, SceneNotFoundError
 from dial.instructions.types import EFFECTORS, Name, Names
@@ -70,8 +70,11 @@ class _Context:
 
 
 class _Checker:
-    def __init__(self, program: Program, source: str, origin: Path, ctx: _Context) -> None:
+    def __init__(
+        self, program: Program, source: str, origin: Path, ctx: _Context, found: int = 0
+    ) -> None:
         self.program = program
+        self.found = found  # the file's problems so far (its syntax problems to begin with)
         self.ctx = ctx
         self.origin = origin  # the real file, for resolving @call and @scene paths
         self.source = source
@@ -87,6 +90,9 @@ class _Checker:
             self.lines = self.source.split("\n")
         text = self.lines[span.line - 1] if 0 < span.line <= len(self.lines) else ""
         self.ctx.diags.append(Diagnostic(self.program.path, span, message, text))
+        self.found += 1
+        if self.found >= MAX_PROBLEMS:
+            raise TooManyProblems(span.line)
 
     def run(self) -> Script:
         self.load_scene()
@@ -147,7 +153,7 @@ class _Checker:
             )
             self.broken.add(d.event)
             return
-        bound, errors = bind(instr, d)
+        bound, errors = bind(instr, d, limit=MAX_PROBLEMS - self.found)
         for span, message in errors:
             self.error(span, f"event '{d.event}': {message}")
         if errors:
@@ -317,7 +323,20 @@ def _check(text: str, path: str, origin: Path, ctx: _Context) -> Script:
     """
     program, syntax = parse_partial(text, path, depth=ctx.depth)
     ctx.diags.extend(syntax)
-    return _Checker(program, text, origin, ctx.entering(origin)).run()
+    if any(isinstance(d, Cutoff) for d in syntax[-1:]):  # the parser stopped: so does the check
+        return _unchecked(program, ctx)
+    checker = _Checker(program, text, origin, ctx.entering(origin), len(syntax))
+    try:
+        return checker.run()
+    except TooManyProblems as stop:
+        lines = text.count("\n") + (not text.endswith("\n"))  # as the scanner counts them
+        ctx.diags.append(Cutoff.at(path, stop.line, lines))
+        return _unchecked(program, ctx)
+
+
+def _unchecked(program: Program, ctx: _Context) -> Script:
+    """A file whose check stopped (its problems are reported): nothing to run."""
+    return Script(program.path, program, {}, frozenset(), (), None, ctx.scene_override)
 
 
 def _check_file(path: Path, display: str, ctx: _Context) -> Script:

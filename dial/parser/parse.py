@@ -10,7 +10,15 @@ from difflib import get_close_matches
 from functools import lru_cache
 from typing import NamedTuple
 
-from dial.errors import Diagnostic, ScriptError, Span, shorten
+from dial.errors import (
+    MAX_PROBLEMS,
+    Cutoff,
+    Diagnostic,
+    ScriptError,
+    Span,
+    TooManyProblems,
+    shorten,
+)
 from dial.parser import directives as args
 from dial.parser.ast import (
     Block,
@@ -96,10 +104,9 @@ _read_short = lru_cache(maxsize=4096)(_read_line)
 class _Parser:
     def __init__(self, text: str, path: str, depth: int = 0) -> None:
         self.path = path
-        self.lines, problems = scan(text)
+        self.lines, self.lexical = scan(text)
         self.diags: list[Diagnostic] = []
-        for span, message in problems:
-            self.error(span, message)
+        self.at = 0  # the line being read (after the last: the end of the file)
         self.structure = Structure(self.error, depth)
         self.block: list[_PendingLine] = []
         self.block_ok = True
@@ -111,11 +118,16 @@ class _Parser:
     def error(self, span: Span, message: str) -> None:
         ln = self.lines[span.line - 1] if 0 < span.line <= len(self.lines) else None  # numbered 1..
         self.diags.append(Diagnostic(self.path, span, message, ln.text if ln else ""))
+        if len(self.diags) >= MAX_PROBLEMS:
+            raise TooManyProblems(span.line)
 
     # -- driver ---------------------------------------------------------------------------
     def run(self) -> Program:
+        for span, message in self.lexical:
+            self.error(span, message)
         execution, comment = Kind.EXECUTION, Kind.COMMENT
         for ln in self.lines:
+            self.at = ln.number
             kind = ln.kind
             if kind is execution:
                 self.execution(ln)
@@ -130,6 +142,7 @@ class _Parser:
                 self.directive(ln)
             elif kind is Kind.OTHER:
                 self.other(ln)
+        self.at = len(self.lines)
         self.flush()
         body = self.structure.finish()
         # The structure reports through this parser: drop it, so that no reference cycle
@@ -365,7 +378,12 @@ def parse_partial(
     towards :data:`~dial.parser.structure.MAX_NESTING`.
     """
     parser = _Parser(text, path, depth)
-    program = parser.run()
+    try:
+        program = parser.run()
+    except TooManyProblems as stop:  # what was read so far, nothing after it
+        program = Program(path, None, None, None, tuple(parser.definitions.values()), ())
+        line = max(stop.line, parser.at)
+        parser.diags.append(Cutoff.at(path, line, len(parser.lines)))
     return program, parser.diags
 
 

@@ -7,7 +7,6 @@ import numpy as np
 from dial.backend.contact import contact_reading
 from dial.backend.locate import finger_bodies, link_point, tactile_point
 from dial.backend.snapshot import FloatArray, Snapshot
-from dial.haptics import FitError, fit_plane, fit_superquadric
 from dial.instructions.catalogue import contact_condition
 from dial.instructions.types import FINGERS
 from dial.primitives.context import Context, RobotPrimitive, done, missed
@@ -155,6 +154,8 @@ class Fit:
         self.kind = info.event.instruction.name
 
     def sense(self, snapshot: Snapshot) -> Ended:
+        from dial.haptics import FitError, fit_plane, fit_superquadric  # SciPy: when fitting
+
         points = np.array(self.ctx.point_sets.get(self.set, []), dtype=np.float64).reshape(-1, 3)
         try:
             fit = fit_plane(points) if self.kind == "fit_plane" else fit_superquadric(points)

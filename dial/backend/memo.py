@@ -1,0 +1,270 @@
+"""The IK's memo: solutions by their exact inputs, in this process and in the user's cache.
+
+A solve depends only on its inputs (the solvers keep no state between calls that changes a
+result), so a repeated problem gives back the very same array: the runs of a script solve
+the same targets, since locations follow the *believed* object poses. In one process (a
+sweep's trials, a notebook, a benchmark) the memo holds what was solved; across processes
+its file in the user's cache folder does, so that a script run again starts without
+loading mink, qpsolvers or SciPy (docs/architecture.md, "Start-up").
+
+The file is named by a **fingerprint** of everything a solution depends on besides its
+inputs: the compiled IK model (its MJB bytes), the source of the solver's modules, the
+versions of MuJoCo, numpy and Python, the installed files of mink, qpsolvers and daqp (their
+sizes and modification times), and the machine. Any change gives another file, so an entry
+is never read where it could differ from a fresh solve. A process writes the file at exit
+only if it solved something new (its own entries last; the oldest beyond :data:`MAX_SAVED`
+dropped), by renaming a whole new file over it. The folder is ``$DIAL_CACHE``, else the
+platform's user cache folder; ``DIAL_CACHE=off`` turns the file off. A folder that is
+missing and cannot be made, is read-only or holds a damaged file is a cache miss, never an
+error. Values are stored with :mod:`marshal` (bytes, floats and tuples only), as Python
+stores its own bytecode cache.
+"""
+
+from __future__ import annotations
+
+import atexit
+import hashlib
+import marshal
+import os
+import sys
+import tempfile
+import time
+from collections import OrderedDict
+from collections.abc import Iterable
+from contextlib import suppress
+from importlib.util import find_spec
+from pathlib import Path
+
+import mujoco
+import numpy as np
+
+FORMAT = b"dial-ik-memo-1"
+MAX_SAVED = 20_000  # entries in one file (about 5 MB; read in about 10 ms)
+STALE_DAYS = 30  # files of other fingerprints untouched this long are removed on a write
+_SOLVER_PACKAGES = ("mink", "qpsolvers", "daqp")
+_OFF = ("", "0", "off", "no", "none", "false")
+
+Key = tuple[object, ...]
+Stored = bytes | tuple[float, ...]  # an array's float64 bytes, or a failed solve's figures
+
+
+def make_key(kind: str, *parts: object) -> Key:
+    """The key of a result computed from these exact inputs (arrays by their bytes)."""
+    return (
+        kind,
+        *(
+            np.ascontiguousarray(p, dtype=np.float64).tobytes() if isinstance(p, np.ndarray) else p
+            for p in parts
+        ),
+    )
+
+
+class Memo:
+    """Results by key: this process's, then those of the file named ``fingerprint``.
+
+    Bounded in memory (oldest first out). Arrays (float64, one axis) and tuples of floats
+    are kept on disk too; anything else (a line's segment) only in this process.
+    """
+
+    SIZE = 50_000
+
+    def __init__(self, fingerprint: str | None) -> None:
+        self.fingerprint = fingerprint
+        self._values: OrderedDict[Key, object] = OrderedDict()
+        self._disk: dict[Key, Stored] | None = None  # read on the first miss
+        self._used: dict[Key, Stored] = {}  # read from the file, or new, in this process
+        self._new = False
+
+    def get(self, key: Key) -> object:
+        value = self._values.get(key)
+        if value is not None or self.fingerprint is None:
+            return value
+        if self._disk is None:
+            self._disk = _read(self.fingerprint)
+        stored = self._disk.get(key)
+        if stored is None:
+            return None
+        self._used[key] = stored
+        value = _decoded(stored)
+        self._keep(key, value)
+        return value
+
+    def put(self, key: Key, value: object) -> None:
+        self._keep(key, value)
+        stored = _stored(key, value) if self.fingerprint is not None else None
+        if stored is not None:
+            self._used[key] = stored
+            if not self._new:
+                self._new = True
+                _WRITERS.append(self)
+
+    def clear(self) -> None:
+        """Forget every result, and do not read the file again (a fresh, uncached process)."""
+        self._values.clear()
+        self._disk = {}
+        self._used.clear()
+
+    def save(self) -> None:
+        """Merge this process's entries into the file, if it solved anything new."""
+        if not self._new or self.fingerprint is None:
+            return
+        self._new = False
+        folder = cache_dir()
+        if folder is None:
+            return
+        old = _read(self.fingerprint)
+        merged = {k: v for k, v in old.items() if k not in self._used}
+        merged.update(self._used)
+        keep = dict(list(merged.items())[-MAX_SAVED:])
+        with suppress(OSError, ValueError):
+            _write(folder / f"{self.fingerprint}.marshal", marshal.dumps(keep))
+
+    def _keep(self, key: Key, value: object) -> None:
+        self._values[key] = value
+        if len(self._values) > self.SIZE:
+            self._values.popitem(last=False)
+
+
+def _stored(key: Key, value: object) -> Stored | None:
+    """``value`` as the file keeps it, or None if it stays in this process."""
+    if not all(type(p) in (str, bytes, int, float, bool) for p in key):
+        return None
+    if isinstance(value, np.ndarray) and value.dtype == np.float64 and value.ndim == 1:
+        return value.tobytes()
+    if isinstance(value, tuple) and all(type(x) is float for x in value):
+        return value
+    return None
+
+
+def _decoded(stored: Stored) -> object:
+    if isinstance(stored, bytes):
+        return np.frombuffer(stored, dtype=np.float64).copy()
+    return stored
+
+
+def cache_dir() -> Path | None:
+    """The folder of the IK's files: ``$DIAL_CACHE``, else the user's cache folder; None
+    when ``DIAL_CACHE`` turns it off."""
+    chosen = os.environ.get("DIAL_CACHE")
+    if chosen is not None:
+        return None if chosen.strip().lower() in _OFF else Path(chosen) / "ik"
+    if sys.platform == "win32":
+        base = Path(os.environ.get("LOCALAPPDATA") or Path.home() / "AppData" / "Local")
+    elif sys.platform == "darwin":
+        base = Path.home() / "Library" / "Caches"
+    else:
+        base = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache")
+    return base / "dial" / "ik"
+
+
+def _read(fingerprint: str) -> dict[Key, Stored]:
+    folder = cache_dir()
+    if folder is None:
+        return {}
+    try:
+        found = marshal.loads((folder / f"{fingerprint}.marshal").read_bytes())
+    except (OSError, EOFError, ValueError, TypeError):
+        return {}  # none yet, unreadable or damaged: solve again
+    if not isinstance(found, dict):
+        return {}
+    return {k: v for k, v in found.items() if isinstance(k, tuple) and isinstance(v, bytes | tuple)}
+
+
+def _write(path: Path, data: bytes) -> None:
+    """Replace ``path`` whole (a reader sees the old file or the new one), then remove the
+    folder's files of other fingerprints that nothing has written for :data:`STALE_DAYS`."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, temp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.stem}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "wb") as f:
+            f.write(data)
+        os.replace(temp, path)
+    except BaseException:
+        with suppress(OSError):
+            os.unlink(temp)
+        raise
+    stale = time.time() - STALE_DAYS * 86400
+    for other in path.parent.iterdir():
+        with suppress(OSError):
+            if other != path and other.stat().st_mtime < stale:
+                other.unlink()
+
+
+def fingerprint(model: mujoco.MjModel, sources: Iterable[str]) -> str | None:
+    """The name of the memo's file for solvers on ``model`` whose code is in ``sources``;
+    None when the cache is off."""
+    if cache_dir() is None:
+        return None
+    h = hashlib.sha256(FORMAT)
+    mjb = np.zeros(mujoco.mj_sizeModel(model), dtype=np.uint8)
+    mujoco.mj_saveModel(model, None, mjb)
+    h.update(mjb.tobytes())
+    machine = os.uname() if hasattr(os, "uname") else (sys.platform,)
+    for text in (sys.version, mujoco.__version__, np.__version__, *machine):
+        h.update(text.encode())
+    for source in sorted(sources):
+        h.update(Path(source).read_bytes())
+    for package in _SOLVER_PACKAGES:
+        h.update(_installed(package).encode())
+    return h.hexdigest()[:32]
+
+
+def _installed(package: str) -> str:
+    """The installed files of ``package`` by size and modification time (not imported)."""
+    spec = find_spec(package)
+    if spec is None or spec.origin is None:
+        return f"{package}: missing"
+    root = Path(spec.origin)
+    if spec.submodule_search_locations:  # a package: every file in its folder
+        root = root.parent
+        files = sorted(p for p in root.rglob("*") if p.suffix != ".pyc")
+    else:
+        files = [root]
+    parts = []
+    for p in files:
+        with suppress(OSError):
+            st = p.stat()
+            parts.append(f"{p.relative_to(root.parent)}:{st.st_size}:{st.st_mtime_ns}")
+    return "\n".join(parts)
+
+
+_MEMOS: dict[str | None, Memo] = {}
+_WRITERS: list[Memo] = []
+
+
+def memo_for(model: mujoco.MjModel, sources: Iterable[str]) -> Memo:
+    """The memo of solvers on ``model`` whose code is in ``sources`` (one per fingerprint)."""
+    name = fingerprint(model, sources)
+    memo = _MEMOS.get(name)
+    if memo is None:
+        memo = _MEMOS[name] = Memo(name)
+    return memo
+
+
+_LINES = Memo(None)  # results built from solves (a line's waypoints): in this process only
+
+
+def recall(kind: str, *parts: object) -> tuple[Key, object]:
+    """The memo's key for a result computed from these exact inputs, and the result if one
+    is known (else None): for results built from solves, such as a line's waypoints."""
+    key = make_key(kind, *parts)
+    return key, _LINES.get(key)
+
+
+def remember(key: Key, value: object) -> None:
+    """Keep ``value`` under ``key`` (from :func:`recall`)."""
+    _LINES.put(key, value)
+
+
+def forget_solutions() -> None:
+    """Empty every memo, and read no file again in this process: the next solves cost what
+    they cost in a fresh process without a cache (benchmarks)."""
+    _LINES.clear()
+    for memo in _MEMOS.values():
+        memo.clear()
+
+
+@atexit.register
+def _save_all() -> None:
+    for memo in _WRITERS:
+        memo.save()
