@@ -20,7 +20,6 @@ from contextlib import contextmanager, suppress
 from pathlib import Path
 from typing import TYPE_CHECKING, TextIO
 
-from dial.disturb import Disturbance, parse_disturbance
 from dial.errors import DialError, OptionError
 from dial.instructions.scene_names import SceneNotFoundError
 from dial.parser.check import load as parse_and_check
@@ -31,6 +30,7 @@ from dial.scene.resolve import scene_option
 
 if TYPE_CHECKING:  # trio and MuJoCo load only to run: `import dial` and checking stay light
     from dial.debug import Break, Console
+    from dial.disturb import Disturbance
     from dial.engine import Observer, RunResult
     from dial.engine.state import Saved
 
@@ -174,6 +174,8 @@ def _checked(
     resume: str | Path | None,
 ) -> tuple[list[Disturbance], Saved | None]:
     """The option checks that need no script: ranges, SPECs, the state files."""
+    from dial.disturb import parse_disturbance
+
     check_options(tick, speed, seed, perturb)
     if resume is not None and (tick is not None or speed != 1.0 or seed or perturb or disturb):
         raise OptionError(

@@ -80,8 +80,9 @@ class Cutoff(Diagnostic):
     compiler stops after so many errors: how many lines it did not check."""
 
     @staticmethod
-    def at(path: str, line: int, lines: int) -> Cutoff:
-        """The check of ``path`` (``lines`` long) stopped at a problem on ``line``."""
+    def at(path: str, line: int, text: str) -> Cutoff:
+        """The check of ``path`` (whose text is ``text``) stopped at a problem on ``line``."""
+        lines = text.count("\n") + (not text.endswith("\n"))  # as the parser counts them
         after = max(lines - line, 0)
         message = (
             f"too many problems: the check stopped at line {line} after {MAX_PROBLEMS}; "
@@ -95,9 +96,15 @@ class TooManyProblems(Exception):
     """Raised inside the checker at a file's :data:`MAX_PROBLEMS`-th problem; the file's
     check ends there (never seen outside :mod:`dial.parser`)."""
 
-    def __init__(self, line: int) -> None:
-        super().__init__(line)
-        self.line = line
+
+def tally(found: int, diags: list[Diagnostic], path: str, line: int, text: str) -> int:
+    """``found``, the problems of the file at ``path`` so far, the latest on ``line``. At
+    :data:`MAX_PROBLEMS` the check of the file stops: its :class:`Cutoff` joins ``diags``,
+    and :class:`TooManyProblems` is raised."""
+    if found >= MAX_PROBLEMS:
+        diags.append(Cutoff.at(path, line, text))
+        raise TooManyProblems
+    return found
 
 
 def _window(line: str, span: Span) -> tuple[str, int, int]:

@@ -13,6 +13,7 @@ import copy
 import os
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import mujoco
 import numpy as np
@@ -20,6 +21,9 @@ from numpy.typing import ArrayLike, NDArray
 
 from dial.errors import DialError
 from dial.resources import data_dir
+
+if TYPE_CHECKING:
+    from dial.scene.world import World
 
 ROBOT_DIR = data_dir("models") / "utah_hand_puma"
 ROBOT_XML = ROBOT_DIR / "utah_hand_puma.xml"
@@ -36,6 +40,19 @@ ARM_HOME = (0.0, 0.7, -3.26, 0.0, -0.58, 0.0)
 
 IntArray = NDArray[np.intp]
 FloatArray = NDArray[np.float64]
+
+
+def scene_bodies(model: mujoco.MjModel, world: World) -> list[int]:
+    """Bodies a perturbation moves: every free body, and the world file's fixed objects."""
+    named = {
+        int(mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, b)) for b in world.objects.values()
+    }
+    free = {
+        int(model.jnt_bodyid[j])
+        for j in range(model.njnt)
+        if model.jnt_type[j] == mujoco.mjtJoint.mjJNT_FREE
+    }
+    return sorted(named | free)
 
 
 def _robot_files() -> dict[str, bytes]:

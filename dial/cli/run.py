@@ -9,10 +9,10 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 from dial.cli.common import UsageError, load_script, scene_argument
+from dial.scheduler.signals import EXIT_STATUS, StopRequest, catch_stop_signals
 
 if TYPE_CHECKING:  # what a run needs loads when it runs: `dial --help` stays quick
     from dial.engine import RunResult
-    from dial.scheduler.signals import StopRequest
 
 DESCRIPTION = (
     "Run a script on the simulated hand and arm. Shows live progress, then each event's "
@@ -114,16 +114,13 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
 def cmd_run(args: argparse.Namespace) -> int:
     # From here to the exit, a stop signal stops the run (which catches it first) or, once
     # the run is over, is ignored: a second Ctrl-C cannot cut the summary or the log short.
-    from dial.scheduler.signals import StopRequest, catch_stop_signals
-
     stop = StopRequest()
     with catch_stop_signals(stop):
         return _run(args, stop)
 
 
 def _run(args: argparse.Namespace, stop: StopRequest) -> int:
-    from dial import api
-    from dial.scheduler.signals import EXIT_STATUS
+    from dial import api  # the parser and the engine: not for --help
 
     if args.log_states and not args.log:
         raise UsageError("--log-states writes into the log: give --log FILE.jsonl too")

@@ -34,8 +34,8 @@ from dial.scheduler.position import Resume
 from dial.scheduler.runner import Runner
 from dial.scheduler.signals import StopRequest, catch_stop_signals
 from dial.scheduler.ticks import Progress
+from dial.scheduler.types import DEFAULT_TICK
 
-DEFAULT_TICK = 0.25  # s, when neither the script (@tick) nor the command line sets one
 MAX_TICK = 60.0  # s, as @tick's range
 
 

@@ -14,7 +14,7 @@ import numpy as np
 from dial.backend.disturb import Disturbances
 from dial.backend.driver import MujocoRobot
 from dial.backend.ik import ArmIK, FingerIK
-from dial.backend.model import ARM_HOME, RobotIndex, hand_ctrl, load_model
+from dial.backend.model import ARM_HOME, RobotIndex, hand_ctrl, load_model, scene_bodies
 from dial.disturb import Disturbance
 from dial.geometry import Pose, location_pose, rpy_matrix
 from dial.parser.script import Script
@@ -29,19 +29,6 @@ SETTLE_S = 0.5  # objects settle on the table before the script starts
 # Where the tool starts when the world file has no "home" location: high above the tables,
 # pointing down (world m; rpy as in world files).
 START = ((0.40, 0.0, 0.80), (np.pi, 0.0, 0.0))
-
-
-def scene_bodies(model: mujoco.MjModel, world: World) -> list[int]:
-    """Bodies a perturbation moves: every free body, and the world file's fixed objects."""
-    named = {
-        int(mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, b)) for b in world.objects.values()
-    }
-    free = {
-        int(model.jnt_bodyid[j])
-        for j in range(model.njnt)
-        if model.jnt_type[j] == mujoco.mjtJoint.mjJNT_FREE
-    }
-    return sorted(named | free)
 
 
 def perturb(model: mujoco.MjModel, world: World, mm: float, seed: int) -> list[float]:

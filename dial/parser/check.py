@@ -10,12 +10,12 @@ from __future__ import annotations
 
 import gc
 from collections.abc import Iterator, Mapping
-from contextlib import contextmanager
+from contextlib import contextmanager, suppress
 from dataclasses import dataclass, field, replace
 from difflib import get_close_matches
 from pathlib import Path
 
-from dial.errors import MAX_PROBLEMS, Cutoff, Diagnostic, ScriptError, Span, TooManyProblems
+from dial.errors import MAX_PROBLEMS, Diagnostic, ScriptError, Span, TooManyProblems, tally
 from dial.instructions.catalogue import INSTRUCTIONS, Instruction
 from dial.instructions.scene_names import SceneLoader, SceneNames, SceneNotFoundError
 from dial.instructions.types import EFFECTORS, Name, Names
@@ -70,11 +70,9 @@ class _Context:
 
 
 class _Checker:
-    def __init__(
-        self, program: Program, source: str, origin: Path, ctx: _Context, found: int = 0
-    ) -> None:
+    def __init__(self, program: Program, source: str, origin: Path, ctx: _Context) -> None:
         self.program = program
-        self.found = found  # the file's problems so far (its syntax problems to begin with)
+        self.seen = 0  # the file's problems so far
         self.ctx = ctx
         self.origin = origin  # the real file, for resolving @call and @scene paths
         self.source = source
@@ -90,9 +88,7 @@ class _Checker:
             self.lines = self.source.split("\n")
         text = self.lines[span.line - 1] if 0 < span.line <= len(self.lines) else ""
         self.ctx.diags.append(Diagnostic(self.program.path, span, message, text))
-        self.found += 1
-        if self.found >= MAX_PROBLEMS:
-            raise TooManyProblems(span.line)
+        self.seen = tally(self.seen + 1, self.ctx.diags, self.program.path, span.line, self.source)
 
     def run(self) -> Script:
         self.load_scene()
@@ -153,7 +149,7 @@ class _Checker:
             )
             self.broken.add(d.event)
             return
-        bound, errors = bind(instr, d, limit=MAX_PROBLEMS - self.found)
+        bound, errors = bind(instr, d, limit=MAX_PROBLEMS - self.seen)
         for span, message in errors:
             self.error(span, f"event '{d.event}': {message}")
         if errors:
@@ -323,19 +319,11 @@ def _check(text: str, path: str, origin: Path, ctx: _Context) -> Script:
     """
     program, syntax = parse_partial(text, path, depth=ctx.depth)
     ctx.diags.extend(syntax)
-    if any(isinstance(d, Cutoff) for d in syntax[-1:]):  # the parser stopped: so does the check
-        return _unchecked(program, ctx)
-    checker = _Checker(program, text, origin, ctx.entering(origin), len(syntax))
-    try:
-        return checker.run()
-    except TooManyProblems as stop:
-        lines = text.count("\n") + (not text.endswith("\n"))  # as the scanner counts them
-        ctx.diags.append(Cutoff.at(path, stop.line, lines))
-        return _unchecked(program, ctx)
-
-
-def _unchecked(program: Program, ctx: _Context) -> Script:
-    """A file whose check stopped (its problems are reported): nothing to run."""
+    checker = _Checker(program, text, origin, ctx.entering(origin))
+    checker.seen = len(syntax)  # a parser that stopped left MAX_PROBLEMS and its Cutoff
+    with suppress(TooManyProblems):  # the check of a file stops there, as compilers do
+        if checker.seen < MAX_PROBLEMS:
+            return checker.run()
     return Script(program.path, program, {}, frozenset(), (), None, ctx.scene_override)
 
 

@@ -10,15 +10,7 @@ from difflib import get_close_matches
 from functools import lru_cache
 from typing import NamedTuple
 
-from dial.errors import (
-    MAX_PROBLEMS,
-    Cutoff,
-    Diagnostic,
-    ScriptError,
-    Span,
-    TooManyProblems,
-    shorten,
-)
+from dial.errors import Diagnostic, ScriptError, Span, TooManyProblems, shorten, tally
 from dial.parser import directives as args
 from dial.parser.ast import (
     Block,
@@ -103,7 +95,7 @@ _read_short = lru_cache(maxsize=4096)(_read_line)
 
 class _Parser:
     def __init__(self, text: str, path: str, depth: int = 0) -> None:
-        self.path = path
+        self.path, self.text = path, text
         self.lines, self.lexical = scan(text)
         self.diags: list[Diagnostic] = []
         self.at = 0  # the line being read (after the last: the end of the file)
@@ -118,8 +110,7 @@ class _Parser:
     def error(self, span: Span, message: str) -> None:
         ln = self.lines[span.line - 1] if 0 < span.line <= len(self.lines) else None  # numbered 1..
         self.diags.append(Diagnostic(self.path, span, message, ln.text if ln else ""))
-        if len(self.diags) >= MAX_PROBLEMS:
-            raise TooManyProblems(span.line)
+        tally(len(self.diags), self.diags, self.path, max(span.line, self.at), self.text)
 
     # -- driver ---------------------------------------------------------------------------
     def run(self) -> Program:
@@ -380,10 +371,8 @@ def parse_partial(
     parser = _Parser(text, path, depth)
     try:
         program = parser.run()
-    except TooManyProblems as stop:  # what was read so far, nothing after it
+    except TooManyProblems:  # what was read so far, nothing after it (its Cutoff is last)
         program = Program(path, None, None, None, tuple(parser.definitions.values()), ())
-        line = max(stop.line, parser.at)
-        parser.diags.append(Cutoff.at(path, line, len(parser.lines)))
     return program, parser.diags
 
 

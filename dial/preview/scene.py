@@ -17,9 +17,8 @@ import numpy as np
 
 from dial.backend.driver import MujocoRobot
 from dial.backend.ik import ArmIK
-from dial.backend.model import ARM_HOME, load_model, load_untextured
+from dial.backend.model import ARM_HOME, load_model, load_untextured, scene_bodies
 from dial.backend.snapshot import FloatArray
-from dial.engine.setup import scene_bodies
 from dial.instructions.types import FINGERS
 from dial.preview.ik import FingerIKOnDemand, LeanArmIK
 from dial.primitives import Context

@@ -1,25 +1,47 @@
-"""The block runner: DIAL timing semantics against a small robot protocol."""
+"""The block runner: DIAL timing semantics against a small robot protocol.
 
-from dial.scheduler.log import EventLog, LogError
-from dial.scheduler.runner import Runner, RunSummary, periods_per_tick
-from dial.scheduler.signals import EXIT_STATUS, StopRequest, catch_stop_signals
-from dial.scheduler.types import (
-    DONE,
-    Ended,
-    Fired,
-    Happening,
-    Interrupted,
-    Monitor,
-    Now,
-    Outcome,
-    Primitive,
-    PrimitiveFactory,
-    Report,
-    Robot,
-    RunAborted,
-    RunInfo,
-    Sensor,
-)
+Each name below is imported from its module when first used (PEP 562): the runner brings
+trio, which the modules that only need the types (the primitives, the preview, ``dial
+world``) do without.
+"""
+
+from importlib import import_module
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from dial.scheduler.log import EventLog, LogError
+    from dial.scheduler.runner import Runner, RunSummary
+    from dial.scheduler.signals import EXIT_STATUS, StopRequest, catch_stop_signals
+    from dial.scheduler.types import (
+        DONE,
+        Ended,
+        Fired,
+        Happening,
+        Interrupted,
+        Monitor,
+        Now,
+        Outcome,
+        Primitive,
+        PrimitiveFactory,
+        Report,
+        Robot,
+        RunAborted,
+        RunInfo,
+        Sensor,
+        periods_per_tick,
+    )
+
+_HOMES = {
+    "dial.scheduler.log": ("EventLog", "LogError"),
+    "dial.scheduler.runner": ("Runner", "RunSummary"),
+    "dial.scheduler.signals": ("EXIT_STATUS", "StopRequest", "catch_stop_signals"),
+    "dial.scheduler.types": (
+        *("DONE", "Ended", "Fired", "Happening", "Interrupted", "Monitor", "Now", "Outcome"),
+        *("Primitive", "PrimitiveFactory", "Report", "Robot", "RunAborted", "RunInfo", "Sensor"),
+        "periods_per_tick",
+    ),
+}
+_HOME = {name: module for module, names in _HOMES.items() for name in names}
 
 __all__ = [
     "DONE",
@@ -46,3 +68,13 @@ __all__ = [
     "catch_stop_signals",
     "periods_per_tick",
 ]
+
+
+def __getattr__(name: str) -> object:
+    """A public name, imported from its module when first used."""
+    home = _HOME.get(name)
+    if home is None:
+        raise AttributeError(f"module 'dial.scheduler' has no attribute '{name}'")
+    value = getattr(import_module(home), name)
+    globals()[name] = value
+    return value

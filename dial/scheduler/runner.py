@@ -9,13 +9,11 @@ clock and the table of active runs. Every record goes through
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import Generic
 
 import trio
 
-from dial.errors import DialError
 from dial.parser.ast import Condition
 from dial.parser.script import (
     Run,
@@ -34,7 +32,15 @@ from dial.scheduler.position import Frame, Hooks, Path, Resume
 from dial.scheduler.records import Records
 from dial.scheduler.signals import StopRequest, catch_stop_signals
 from dial.scheduler.ticks import Observe, Progress, TickLoop
-from dial.scheduler.types import Interrupted, Outcome, PrimitiveFactory, Robot, RunAborted, S
+from dial.scheduler.types import (
+    Interrupted,
+    Outcome,
+    PrimitiveFactory,
+    Robot,
+    RunAborted,
+    S,
+    periods_per_tick,
+)
 
 Ending = TResume | TRetry | TAbort  # how a reaction ends, once one of these is executed
 
@@ -55,13 +61,6 @@ class RunSummary:
     tick_length: float
     outcomes: dict[str, int]
     interrupted: str | None = None
-
-
-def periods_per_tick(tick: float, period: float) -> int:
-    """Ticks are whole numbers of control periods."""
-    if not math.isfinite(tick) or round(tick / period) < 1:
-        raise DialError(f"tick length {tick:g} s is shorter than the control period {period:g} s")
-    return round(tick / period)
 
 
 class Runner(Generic[S]):

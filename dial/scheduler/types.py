@@ -7,6 +7,7 @@ zero-length sensing) per run through a :data:`PrimitiveFactory`.
 
 from __future__ import annotations
 
+import math
 from abc import ABC, abstractmethod
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -23,6 +24,16 @@ S_contra = TypeVar("S_contra", contravariant=True)
 
 # What a run reports for the log: JSON-able values (numbers, strings, lists, arrays).
 Data = Mapping[str, object]
+
+
+DEFAULT_TICK = 0.25  # s, when neither the script (@tick) nor the command line sets one
+
+
+def periods_per_tick(tick: float, period: float) -> int:
+    """Ticks are whole numbers of control periods."""
+    if not math.isfinite(tick) or round(tick / period) < 1:
+        raise DialError(f"tick length {tick:g} s is shorter than the control period {period:g} s")
+    return round(tick / period)
 
 
 class Outcome(StrEnum):
