@@ -205,6 +205,8 @@ def _pausing(
     script: Script, breaks: Sequence[str], step: bool, console: Console | None
 ) -> tuple[list[Break], Console | None]:
     """The breakpoints, and where a paused run reads commands (a terminal, else stdin)."""
+    if not (breaks or step):  # the debugger loads only for a run that pauses
+        return [], console
     from dial.debug import LineConsole, TerminalConsole, parse_break
 
     stops = [parse_break(b, _event_names(script)) for b in breaks]

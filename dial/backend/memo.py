@@ -32,6 +32,7 @@ import time
 from collections import OrderedDict
 from collections.abc import Iterable
 from contextlib import suppress
+from functools import cache
 from importlib.util import find_spec
 from pathlib import Path
 
@@ -195,18 +196,23 @@ def fingerprint(model: mujoco.MjModel, sources: Iterable[str]) -> str | None:
     None when the cache is off."""
     if cache_dir() is None:
         return None
-    h = hashlib.sha256(FORMAT)
+    h = hashlib.sha256(_setting(tuple(sorted(sources))))
     mjb = np.zeros(mujoco.mj_sizeModel(model), dtype=np.uint8)
     mujoco.mj_saveModel(model, None, mjb)
     h.update(mjb.tobytes())
-    machine = os.uname() if hasattr(os, "uname") else (sys.platform,)
-    for text in (sys.version, mujoco.__version__, np.__version__, *machine):
-        h.update(text.encode())
-    for source in sorted(sources):
-        h.update(Path(source).read_bytes())
-    for package in _SOLVER_PACKAGES:
-        h.update(_installed(package).encode())
     return h.hexdigest()[:32]
+
+
+@cache
+def _setting(sources: tuple[str, ...]) -> bytes:
+    """What a solution depends on besides its model and inputs, once per process: the
+    format, Python, MuJoCo and numpy, the machine, the solvers' code and packages."""
+    machine = os.uname() if hasattr(os, "uname") else (sys.platform,)
+    parts = [FORMAT, *(s.encode() for s in (sys.version, mujoco.__version__, np.__version__))]
+    parts += [s.encode() for s in machine]
+    parts += [Path(source).read_bytes() for source in sources]
+    parts += [_installed(package).encode() for package in _SOLVER_PACKAGES]
+    return hashlib.sha256(b"\0".join(parts)).digest()
 
 
 def _installed(package: str) -> str:
@@ -214,18 +220,20 @@ def _installed(package: str) -> str:
     spec = find_spec(package)
     if spec is None or spec.origin is None:
         return f"{package}: missing"
-    root = Path(spec.origin)
-    if spec.submodule_search_locations:  # a package: every file in its folder
-        root = root.parent
-        files = sorted(p for p in root.rglob("*") if p.suffix != ".pyc")
-    else:
-        files = [root]
-    parts = []
-    for p in files:
-        with suppress(OSError):
-            st = p.stat()
-            parts.append(f"{p.relative_to(root.parent)}:{st.st_size}:{st.st_mtime_ns}")
-    return "\n".join(parts)
+    if not spec.submodule_search_locations:  # a module: its file
+        return _stat(spec.origin)
+    found = []
+    for folder, _, files in os.walk(os.path.dirname(spec.origin)):  # a package: its folder
+        found += [_stat(os.path.join(folder, f)) for f in files if not f.endswith(".pyc")]
+    return "\n".join(sorted(found))
+
+
+def _stat(path: str) -> str:
+    try:
+        st = os.stat(path)
+    except OSError:
+        return f"{path}: missing"
+    return f"{path}:{st.st_size}:{st.st_mtime_ns}"
 
 
 _MEMOS: dict[str | None, Memo] = {}

@@ -7,6 +7,7 @@ Exit status: 0 success, 1 a script or run error (or a failed criterion), 2 a usa
 from __future__ import annotations
 
 import argparse
+import gc
 import os
 import signal
 import sys
@@ -53,6 +54,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         # into death by signal while the interpreter tears MuJoCo and trio down.
         for sig in (signal.SIGINT, signal.SIGTERM):
             signal.signal(sig, signal.SIG_IGN)
+        # Nor need the interpreter's last garbage collections walk all it made (0.05 s).
+        gc.freeze()
     return status
 
 

@@ -12,15 +12,13 @@ import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TextIO
+from typing import TYPE_CHECKING, TextIO
 
 import trio
 
 from dial.backend.driver import MujocoRobot
 from dial.backend.snapshot import Snapshot
-from dial.debug import Break, Console, Session
 from dial.disturb import Disturbance, parse_disturbance
-from dial.engine.debugging import session
 from dial.engine.observe import Observer, StateLog, Watched, describe, fan_out, first_line
 from dial.engine.result import RunResult, measure_criteria
 from dial.engine.setup import prepare
@@ -35,6 +33,9 @@ from dial.scheduler.runner import Runner
 from dial.scheduler.signals import StopRequest, catch_stop_signals
 from dial.scheduler.ticks import Progress
 from dial.scheduler.types import DEFAULT_TICK
+
+if TYPE_CHECKING:  # a run that pauses or saves brings the debugger: others do without it
+    from dial.debug import Break, Console, Session
 
 MAX_TICK = 60.0  # s, as @tick's range
 
@@ -86,7 +87,8 @@ def run(script: Script, options: RunOptions) -> RunResult:
         log = EventLog(options.log)
         settings = _settings(script, options)
         disturb = [parse_disturbance(d) for d in settings.disturb]
-        robot, ctx = prepare(script, log, settings.perturb_mm, settings.seed, disturb)
+        drawn = bool(options.observers)  # an observer may draw: it gets the scene's textures
+        robot, ctx = prepare(script, log, settings.perturb_mm, settings.seed, disturb, drawn)
         resume = _resume(script, options.resume, robot, ctx, log)
         states = [StateLog(lanes=LanePlan.from_script(script))] if options.log_states else []
         begun: list[Observer] = []
@@ -171,6 +173,8 @@ def _debugging(
     """The session's hooks, if the run pauses or saves; None keeps the runner's hot path lean."""
     if not (options.breaks or options.step or options.save_at):
         return None
+    from dial.engine.debugging import session
+
     return session(
         script,
         runner,
