@@ -14,11 +14,11 @@ from __future__ import annotations
 import argparse
 import time
 
-from dial.backend.ik import forget_solutions
 from dial.engine import RunOptions, run
 from dial.parser import load
 from dial.preview import preview
 from dial.resources import resolve_script
+from dial.robot.memo import forget_solutions
 from dial.scene import load_scene_names
 
 

@@ -19,7 +19,7 @@ ROOT = Path(__file__).resolve().parent.parent
 DATA = ROOT / "tests" / "data"
 UPDATE = os.environ.get("DIAL_UPDATE_GOLDEN") == "1"
 
-# The IK's cache (dial.backend.memo) of this session, and of the processes it starts: a
+# The IK's cache (dial.robot.memo) of this session, and of the processes it starts: a
 # folder of its own, empty at the start, never the user's; removed at exit, after the memo
 # has written it (atexit runs the later registration first).
 if "DIAL_CACHE" not in os.environ:

@@ -107,7 +107,7 @@ def test_no_monitor_outside_its_watched_span() -> None:
     assert quiet.ends("arm") == [(6, pytest.approx(0.6), "done")]
     fires = run_fake(text, tick=0.1, holds={"slip": {11}})  # the span's first period
     assert records(fires, "monitor")[0]["period"] == 11
-    assert fires.robot.armed == [(11, "slip", False)]
+    assert fires.robot.watched == [(11, "slip", False)]
 
 
 def test_a_condition_that_holds_already_fires_in_the_first_period_of_the_span() -> None:

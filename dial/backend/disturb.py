@@ -17,7 +17,7 @@ import mujoco
 import numpy as np
 
 from dial.disturb import Disturbance, DisturbanceError, Dropout, Push
-from dial.scheduler.types import Happening
+from dial.robot.protocol import Happening
 
 
 @dataclass(frozen=True)

@@ -1,7 +1,7 @@
 """The MuJoCo driver: the single owner of the physics.
 
 Each control period the runner hands primitives a :class:`Snapshot`; they write set-points
-into their own effectors' command slots (:class:`~dial.backend.slots.Slots`). The driver
+into their own effectors' command slots (:class:`~dial.robot.slots.Slots`). The driver
 then applies the slots and steps the physics. Guards (guarded moves) and monitors (watched
 spans) are tested after every physics step, so a contact freezes its effector, or fires
 its monitor, at the step where it is first sensed. Engine-owned safety monitors run every
@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
 from dataclasses import replace
+from typing import TYPE_CHECKING
 
 import mujoco
 import numpy as np
@@ -20,15 +21,23 @@ from numpy.typing import NDArray
 from dial.backend.disturb import Disturbances
 from dial.backend.guards import Guard, Guards, Readings
 from dial.backend.locate import finger_bodies, link_point, tactile_point
-from dial.backend.model import HAND_JOINTS, IntArray, RobotIndex, hand_ctrl, tendon_differentials
+from dial.backend.model import IntArray, RobotIndex, hand_ctrl, robot_view, tendon_differentials
 from dial.backend.safety import Safety
-from dial.backend.slots import ArmCourse, still
-from dial.backend.snapshot import FloatArray, Snapshot, Trip, frozen
-from dial.instructions.catalogue import contact_condition
 from dial.instructions.types import FINGERS
+from dial.robot.protocol import (
+    Course,
+    Fired,
+    Happening,
+    Monitor,
+    Report,
+    Robot,
+    StopFlag,
+    advance_through,
+)
+from dial.robot.slots import ArmCourse, still
+from dial.robot.snapshot import FloatArray, Snapshot, Touch, Trip, frozen
+from dial.robot.view import RobotView
 from dial.scene.thread import Thread, find_threads
-from dial.scheduler.signals import StopRequest
-from dial.scheduler.types import Course, Fired, Happening, Monitor, Report, advance_through
 
 CONTROL_PERIOD = 0.01  # s; physics runs at the model's timestep (0.002 s)
 
@@ -42,7 +51,7 @@ def as_slice(index: IntArray) -> slice | IntArray:
 
 
 class MujocoRobot:
-    """The robot protocol of :mod:`dial.scheduler` on a MuJoCo model."""
+    """The robot protocol (:class:`dial.robot.protocol.Robot`) on a MuJoCo model."""
 
     def __init__(
         self,
@@ -83,11 +92,11 @@ class MujocoRobot:
         self._tendon_pairs = tendons.reshape(16, 2) if tendons.base is not None else None
         self._finger_bodies = tuple(finger_bodies(model, f) for f in range(len(FINGERS)))
         self._taxel_frames: dict[int, tuple[int, FloatArray]] = {}  # see _taxels
-        hand_joints = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, n) for n in HAND_JOINTS]
-        self.hand_range = model.jnt_range[hand_joints].copy()  # (16, 2) rad, mask order
-        self.hand_range.flags.writeable = False
-        self.arm_range = model.jnt_range[model.actuator_trnid[ix.arm_actuators, 0]].copy()
-        self.arm_range.flags.writeable = False  # (6, 2) rad, joints 1-6
+        self._view = robot_view(model, ix)
+
+    @property
+    def view(self) -> RobotView:
+        return self._view
 
     # -- the scheduler's robot protocol ---------------------------------------------------------
     @property
@@ -153,11 +162,11 @@ class MujocoRobot:
         self._apply()
         m, d = self.model, self.data
         due = self.disturbances.due(self.steps, self.substeps)
-        if not self.guards.armed and not self.threads and not due:
+        if not self.guards.tested and not self.threads and not due:
             mujoco.mj_step(m, d, nstep=self.substeps)
             self.steps += self.substeps
         else:
-            armed, threads = self.guards.armed, self.threads  # read after every physics step
+            tested, threads = self.guards.tested, self.threads  # read after every physics step
             for _ in range(self.substeps):
                 if due:
                     self.disturbances.apply(self.steps, d, self._happened, self.time)
@@ -167,7 +176,7 @@ class MujocoRobot:
                     if thread.update(d):
                         fields = {"name": thread.name, "t": self.time, "step": self.steps}
                         self._happened.append(Happening("thread", fields))
-                if armed:
+                if tested:
                     self._check_guards()
         return self._reported(self.safety.check(self.time, self._happened))
 
@@ -181,14 +190,14 @@ class MujocoRobot:
         return report
 
     def coast(
-        self, writes: Sequence[Course], periods: int, stop: StopRequest
+        self, writes: Sequence[Course], periods: int, stop: StopFlag
     ) -> tuple[int, Report | None]:
         """``advance`` up to ``periods`` times, each after writing that period's set-points
         (``write(k)`` for the k-th); it returns after a period that reports anything, or a
         stop signal, with the number of periods taken. With no guard, thread or disturbance
         in the way this is :meth:`advance` unrolled, as lean as a period can be."""
         n = self.substeps
-        if self.guards.armed or self.threads or self.disturbances.due(self.steps, periods * n):
+        if self.guards.tested or self.threads or self.disturbances.due(self.steps, periods * n):
             return advance_through(self, writes, periods, stop)
         m, d, safety, happened = self.model, self.data, self.safety, self._happened
         writes = [w for w in writes if w is not still]
@@ -234,17 +243,19 @@ class MujocoRobot:
                 self.set_limp(joints, False)
         self._apply()
 
-    def arm(self, monitor: Monitor) -> int:
-        event = monitor.event
-        kind, finger, threshold = contact_condition(event.instruction, event.args)
+    def watch(self, monitor: Monitor) -> int:
+        kind, finger, threshold = monitor.contact
         baseline = tendon_differentials(self.data, self.index)
         guard = Guard(None, ((kind, threshold),), (finger,), baseline, monitor.negated)
-        key = self.guards.arm(guard)
+        key = self.guards.add(guard)
         self.monitors.add(key)
         return key
 
-    def disarm(self, key: int) -> None:
-        self.guards.disarm(key)
+    def unwatch(self, key: int) -> None:
+        self._untest(key)
+
+    def _untest(self, key: int) -> None:
+        self.guards.remove(key)
         self.monitors.discard(key)
         self._trips.pop(key, None)
 
@@ -258,14 +269,27 @@ class MujocoRobot:
         """(16,) hand joint angles now (rad, mask order)."""
         return np.asarray(self.data.qpos[self.index.hand_qpos], dtype=np.float64)
 
-    def arm_guard(
+    def guard(
         self, effector: str, conditions: Iterable[tuple[str, float]], sense: Iterable[int]
     ) -> int:
-        """Arm a guard on ``effector``; it is tested after every physics step until it trips."""
+        """Guard ``effector``: tested after every physics step until it trips."""
         baseline = tendon_differentials(self.data, self.index)
-        return self.guards.arm(Guard(effector, tuple(conditions), tuple(sense), baseline))
+        return self.guards.add(Guard(effector, tuple(conditions), tuple(sense), baseline))
 
-    def taxel_points(self, finger: int) -> FloatArray:
+    def unguard(self, key: int) -> None:
+        self._untest(key)
+
+    def touch(self, finger: int) -> Touch:
+        """Where ``finger`` touches now (a dropped-out tactile array locates nothing; see
+        :mod:`dial.backend.locate`)."""
+        tactile = None
+        if ("tactile", finger) not in self.disturbances.dropped:
+            a = self._tactile_adr[finger]
+            depths = self.data.sensordata[a : a + 256]
+            tactile = tactile_point(depths, self._taxel_points(finger))
+        return Touch(tactile, link_point(self.model, self.data, self._finger_bodies[finger]))
+
+    def _taxel_points(self, finger: int) -> FloatArray:
         """(256, 3) world positions of a fingertip's taxels, in sensor order (m)."""
         geom, local = self._taxels(finger)
         rot = self.data.geom_xmat[geom].reshape(3, 3)
@@ -306,7 +330,7 @@ class MujocoRobot:
                 self._fired.append(Fired(key, trip.time, trip.step))
                 self.monitors.discard(key)
                 continue
-            self._trips[key] = trip = self._located(trip)
+            self._trips[key] = trip = replace(trip, touch=self.touch(trip.finger))
             self._freeze(guard.effector)
             self._happened.append(
                 Happening(
@@ -322,17 +346,6 @@ class MujocoRobot:
                 )
             )
 
-    def _located(self, trip: Trip) -> Trip:
-        """``trip`` with where its finger touches at this physics step (a dropped-out tactile
-        array locates nothing; see :mod:`dial.backend.locate`)."""
-        f = trip.finger
-        tactile = None
-        if ("tactile", f) not in self.disturbances.dropped:
-            a = self._tactile_adr[f]
-            tactile = tactile_point(self.data.sensordata[a : a + 256], self.taxel_points(f))
-        link = link_point(self.model, self.data, self._finger_bodies[f])
-        return replace(trip, tactile=tactile, link=link)
-
     def _freeze(self, effector: str) -> None:
         """Hold the guarded effector where it is, at this physics step."""
         ix, d = self.index, self.data
@@ -342,3 +355,7 @@ class MujocoRobot:
             f = FINGERS.index(effector)
             self.hand_target[4 * f : 4 * f + 4] = d.qpos[ix.hand_qpos[4 * f : 4 * f + 4]]
         self._apply()
+
+
+if TYPE_CHECKING:  # mypy checks here that the simulated robot implements the whole seam
+    _IMPLEMENTS: type[Robot[Snapshot]] = MujocoRobot

@@ -3,7 +3,7 @@
 A **guard** belongs to a guarded move: when it trips, the driver freezes the guarded
 effector at that physics step. A **monitor** belongs to a watched span (DESIGN 2.7): it
 freezes nothing; the runner preempts the block. Both read the same contact readings as a
-contact wait does (:func:`~dial.backend.contact.contact_reading`), so a guard, a monitor
+contact wait does (:func:`~dial.robot.contact.contact_reading`), so a guard, a monitor
 and a wait mean the same contact.
 """
 
@@ -15,9 +15,9 @@ from dataclasses import dataclass, field
 import mujoco
 import numpy as np
 
-from dial.backend.contact import POSITION_LEVER
 from dial.backend.model import RobotIndex, tendon_tensions
-from dial.backend.snapshot import FloatArray, Trip
+from dial.robot.contact import POSITION_LEVER
+from dial.robot.snapshot import FloatArray, Trip
 
 
 @dataclass(frozen=True)
@@ -39,7 +39,7 @@ class Guard:
 class Readings:
     """What guards and monitors read at one physics step, computed only as far as they need
     (this runs after every physics step while one is armed). The formulas are
-    :func:`~dial.backend.contact.contact_reading`'s; a dropped-out sensor reads 0. One per
+    :func:`~dial.robot.contact.contact_reading`'s; a dropped-out sensor reads 0. One per
     robot: :meth:`at_step` starts each step afresh."""
 
     __slots__ = (
@@ -117,33 +117,34 @@ def first_trip(guard: Guard, r: Readings, time: float, step: int) -> Trip | None
 
 
 class Guards:
-    """The armed guards and monitors, by key, in the order they were armed."""
+    """The guards and monitors tested after every physics step, by key, in the order they
+    were added."""
 
     def __init__(self) -> None:
-        self.armed: dict[int, Guard] = {}
+        self.tested: dict[int, Guard] = {}
         self._next = 0
 
     def __bool__(self) -> bool:
-        return bool(self.armed)
+        return bool(self.tested)
 
-    def arm(self, guard: Guard) -> int:
+    def add(self, guard: Guard) -> int:
         self._next += 1
-        self.armed[self._next] = guard
+        self.tested[self._next] = guard
         return self._next
 
-    def disarm(self, key: int) -> None:
-        self.armed.pop(key, None)
+    def remove(self, key: int) -> None:
+        self.tested.pop(key, None)
 
     def clear(self) -> None:
-        self.armed.clear()
+        self.tested.clear()
 
     def check(self, readings: Readings, time: float, step: int) -> list[tuple[int, Guard, Trip]]:
-        """The guards that trip at this step (each is disarmed: it fires once)."""
+        """The guards that trip at this step (each is removed: it fires once)."""
         tripped: list[tuple[int, Guard, Trip]] = []
-        for key, guard in self.armed.items():
+        for key, guard in self.tested.items():
             trip = first_trip(guard, readings, time, step)
             if trip is not None:
                 tripped.append((key, guard, trip))
         for key, _, _ in tripped:
-            del self.armed[key]
+            del self.tested[key]
         return tripped

@@ -4,7 +4,7 @@ The IK model holds only the arm and hand (no scene objects), so its QP stays at
 22 velocities whatever the scene holds. Solutions are warm-started from the last
 one: a straight-line move solves one waypoint per control period.
 
-Every solution is memoized by its exact inputs (:mod:`dial.backend.memo`, also kept in the
+Every solution is memoized by its exact inputs (:mod:`dial.robot.memo`, also kept in the
 user's cache folder), and mink is imported, and its tasks set up, only when a solver first
 meets a problem that the memo does not hold: a run whose solves are all known never loads
 mink, qpsolvers or SciPy. Forward kinematics needs only MuJoCo.
@@ -19,10 +19,11 @@ from typing import TYPE_CHECKING
 import mujoco
 import numpy as np
 
-from dial.backend.memo import forget_solutions, make_key, memo_for, recall, remember
+from dial.backend.fingerprint import fingerprint
 from dial.backend.model import RobotIndex, load_model
-from dial.backend.snapshot import FloatArray
 from dial.errors import DialError
+from dial.robot.memo import memo_for, memo_key
+from dial.robot.snapshot import FloatArray
 
 if TYPE_CHECKING:
     import mink
@@ -51,7 +52,7 @@ class _Base:
             for c in type(self).__mro__
             if c.__module__.startswith("dial.")
         }
-        self.memo = memo_for(self.model, [f for f in code if f is not None])
+        self.memo = memo_for(fingerprint(self.model, [f for f in code if f is not None]))
         self._kinematics = mujoco.MjData(self.model)  # for fk, apart from mink's
 
     @cached_property
@@ -130,7 +131,7 @@ class ArmIK(_Base):
         self, pos: FloatArray, rot: FloatArray, arm_q: FloatArray, iterations: int = 2
     ) -> FloatArray:
         """A few warm-started steps from ``arm_q`` toward the pose: one waypoint of a line."""
-        key = make_key(f"{self.MEMO}-track", pos, rot, arm_q, iterations)
+        key = memo_key(f"{self.MEMO}-track", pos, rot, arm_q, iterations)
         known = self.memo.get(key)
         if isinstance(known, np.ndarray):
             return known.copy()
@@ -149,7 +150,7 @@ class ArmIK(_Base):
         converges wins. Deterministic.
         """
         start = np.asarray(arm_q, dtype=np.float64)
-        key = make_key(f"{self.MEMO}-solve", pos, rot, start)
+        key = memo_key(f"{self.MEMO}-solve", pos, rot, start)
         known = self.memo.get(key)
         closest = known if isinstance(known, tuple) else (np.inf, np.inf)
         if isinstance(known, np.ndarray):
@@ -230,7 +231,7 @@ class FingerIK(_Base):
         iterations: int = 2,
     ) -> FloatArray:
         """Steps from ``hand_q`` moving the fingertip toward ``tip`` (world, m); returns (16,)."""
-        key = make_key("finger-track", int(finger), tip, arm_q, hand_q, iterations)
+        key = memo_key("finger-track", int(finger), tip, arm_q, hand_q, iterations)
         known = self.memo.get(key)
         if isinstance(known, np.ndarray):
             return known.copy()
@@ -261,18 +262,3 @@ class FingerIK(_Base):
         q: FloatArray = self.config.q[self.index.hand_qpos].copy()
         self.memo.put(key, q.copy())
         return q
-
-
-__all__ = [
-    "DAMPING",
-    "DT",
-    "POS_TOL",
-    "ROT_TOL",
-    "SOLVER",
-    "ArmIK",
-    "FingerIK",
-    "IKError",
-    "forget_solutions",
-    "recall",
-    "remember",
-]

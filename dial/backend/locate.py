@@ -13,8 +13,8 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
-from dial.backend.snapshot import FloatArray
 from dial.instructions.types import FINGERS
+from dial.robot.snapshot import FloatArray
 
 
 def tactile_point(depths: FloatArray, taxels: FloatArray) -> FloatArray | None:

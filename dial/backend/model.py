@@ -21,6 +21,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from dial.errors import DialError
 from dial.resources import data_dir
+from dial.robot.view import FingerView, RobotView
 
 if TYPE_CHECKING:
     from dial.scene.world import World
@@ -220,6 +221,34 @@ class RobotIndex:
             moment_arm=float(np.abs(model.wrap_prm[model.tendon_adr[tendon_ids]]).max()),
             tension_limit=float(model.actuator_forcerange[tendons, 1].max()),
         )
+
+
+def robot_view(model: mujoco.MjModel, index: RobotIndex) -> RobotView:
+    """The read-only view of the Utah/MIT hand on the PUMA in ``model`` (its ranges as the
+    model has them)."""
+    fingers = []
+    for f, name in enumerate(FINGERS):
+        prefix = f"hand_{name}_"
+        bodies = tuple(
+            n for n in (model.body(b).name for b in range(model.nbody)) if n.startswith(prefix)
+        )
+        joints = HAND_JOINTS[4 * f : 4 * f + 4]
+        fingers.append(FingerView(name, joints, f"{prefix}tip", f"{prefix}tactile", bodies))
+    hand = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, n) for n in HAND_JOINTS]
+    hand_range = model.jnt_range[hand].copy()
+    arm_range = model.jnt_range[model.actuator_trnid[index.arm_actuators, 0]].copy()
+    for array in (hand_range, arm_range):
+        array.flags.writeable = False
+    return RobotView(
+        "utah_hand_puma",
+        ARM_JOINTS,
+        arm_range,
+        "hand_palm",
+        tuple(fingers),
+        hand_range,
+        "tendon",
+        TAXEL_SHAPE,
+    )
 
 
 def hand_ctrl(q_desired: ArrayLike) -> FloatArray:

@@ -11,7 +11,7 @@ import numpy as np
 
 from dial.backend.model import RobotIndex
 from dial.instructions.types import FINGERS
-from dial.scheduler.types import Happening
+from dial.robot.protocol import Happening
 
 SATURATION_LIMIT_S = 1.0  # a tendon pinned at its tension limit this long is logged
 LIMIT_SLACK = 0.05  # rad: the servo may press a joint this far into its limit stop

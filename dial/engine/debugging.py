@@ -22,6 +22,7 @@ from dial.scheduler.ticks import TickLoop
 def session(
     top: Script,
     runner: Runner[Any],
+    robot: MujocoRobot,
     ctx: Context,
     stop: StopRequest,
     settings: state.RunSettings,
@@ -32,7 +33,6 @@ def session(
     save_at: tuple[int, Path] | None,
 ) -> Session:
     """A session whose ``state`` reads this robot and whose ``save`` writes state files."""
-    robot = ctx.robot
 
     def where() -> str:
         assert runner.loop is not None

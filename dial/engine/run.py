@@ -17,7 +17,6 @@ from typing import TYPE_CHECKING, TextIO
 import trio
 
 from dial.backend.driver import MujocoRobot
-from dial.backend.snapshot import Snapshot
 from dial.disturb import Disturbance, parse_disturbance
 from dial.engine.observe import Observer, StateLog, Watched, describe, fan_out, first_line
 from dial.engine.result import RunResult, measure_criteria
@@ -27,6 +26,7 @@ from dial.errors import DialError, OptionError
 from dial.parser.lanes import LanePlan
 from dial.parser.script import Script
 from dial.primitives import Context, make_factory
+from dial.robot.snapshot import Snapshot
 from dial.scheduler.log import EventLog
 from dial.scheduler.position import Resume
 from dial.scheduler.runner import Runner
@@ -107,7 +107,9 @@ def run(script: Script, options: RunOptions) -> RunResult:
                 pace=1.0 if options.realtime else None,
                 stop=stop,
             )
-            hooks = runner.hooks = _debugging(script, runner, ctx, stop, settings, begun, options)
+            hooks = runner.hooks = _debugging(
+                script, runner, robot, ctx, stop, settings, begun, options
+            )
             start, cpu = time.perf_counter(), time.process_time()
             summary = trio.run(runner.run, script, resume)
             wall, cpu = time.perf_counter() - start, time.process_time() - cpu
@@ -164,6 +166,7 @@ def _settings(script: Script, options: RunOptions) -> RunSettings:
 def _debugging(
     script: Script,
     runner: Runner[Snapshot],
+    robot: MujocoRobot,
     ctx: Context,
     stop: StopRequest,
     settings: RunSettings,
@@ -178,6 +181,7 @@ def _debugging(
     return session(
         script,
         runner,
+        robot,
         ctx,
         stop,
         settings,

@@ -95,4 +95,4 @@ def prepare(
     where = world.path.name if bundled else str(world.path)
     log.write("scene", scene=world.name, world=where, perturb=shift, seed=seed)
     robot = MujocoRobot(model, data, disturbances=placed)
-    return robot, Context(robot, world, believed, ik, FingerIK(ik.model))  # one IK model
+    return robot, Context(robot, robot.view, world, believed, ik, FingerIK(ik.model))

@@ -29,7 +29,7 @@ from dial.backend.driver import MujocoRobot
 from dial.errors import DialError
 from dial.parser.script import Script, Step, TBlock, TCall, TIf, TRepeat, scripts_of
 from dial.primitives import Context
-from dial.primitives.context import StopContact
+from dial.robot.snapshot import Touch
 from dial.scheduler.position import Frame, Resume
 from dial.scheduler.position import Path as TimelinePath
 from dial.scheduler.ticks import TickLoop
@@ -297,7 +297,7 @@ class Saved:
         robot.disturbances.resume_at(robot.steps)
         ctx.point_sets.update(d["contacts"])
         for f, (tactile, link) in d.get("stops", {}).items():
-            ctx.stops[int(f)] = StopContact(_stop_point(tactile), _stop_point(link))
+            ctx.stops[int(f)] = Touch(_stop_point(tactile), _stop_point(link))
         ctx.results.update(d["results"])
         for body, pos in d.get("believed", {}).items():  # as `locate` left them
             if body in ctx.believed:

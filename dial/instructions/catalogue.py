@@ -20,6 +20,8 @@ from dial.instructions.types import (
     FINGERS,
     Choice,
     Conditions,
+    Contact,
+    ContactKind,
     Finger,
     Integer,
     Mask,
@@ -78,7 +80,7 @@ class Instruction:
     primitive: str = ""
     # For the contact instructions: the contact kind (tactile, force, position) their
     # condition reads; only these can be watched with '~' (DESIGN 2.7).
-    condition: str | None = None
+    condition: ContactKind | None = None
 
     def spec(self, name: str) -> ParamSpec | None:
         return next((p for p in self.params if p.name == name), None)
@@ -161,7 +163,10 @@ def _sensing(name: str, summary: str) -> Instruction:
     return Instruction(name, "zero", (), _none, name, summary, sensing=True, primitive="Get")
 
 
-def _contact(name: str, dim_unit: tuple[str, str], default: float, what: str) -> Instruction:
+def _contact(
+    kind: ContactKind, dim_unit: tuple[str, str], default: float, what: str
+) -> Instruction:
+    name = f"{kind}_contact"
     dim, unit = dim_unit
     threshold = Quantity(dim, unit, 0.0, 1000.0, lo_open=True)  # type: ignore[arg-type]
     return Instruction(
@@ -173,7 +178,7 @@ def _contact(name: str, dim_unit: tuple[str, str], default: float, what: str) ->
         f"Wait until {what} on the finger passes the threshold.",
         sensing=True,
         primitive="ContactWait",
-        condition=name.removesuffix("_contact"),
+        condition=kind,
     )
 
 
@@ -251,9 +256,9 @@ INSTRUCTIONS: dict[str, Instruction] = {
             positional_counts=(3, 6),
             primitive="ArmMove",
         ),
-        _contact("position_contact", ("length", "mm"), 0.003, "the fingertip position error"),
-        _contact("force_contact", ("force", "N"), 0.5, "the change in tendon force differential"),
-        _contact("tactile_contact", ("length", "mm"), 0.0001, "the deepest taxel reading"),
+        _contact("position", ("length", "mm"), 0.003, "the fingertip position error"),
+        _contact("force", ("force", "N"), 0.5, "the change in tendon force differential"),
+        _contact("tactile", ("length", "mm"), 0.0001, "the deepest taxel reading"),
         Instruction(
             "grasp_force",
             "indeterminate",
@@ -385,11 +390,11 @@ INSTRUCTIONS: dict[str, Instruction] = {
 }
 
 
-def contact_condition(instruction: Instruction, args: Args) -> tuple[str, int, float]:
-    """(kind, finger, threshold) of a contact instruction's condition: it holds when the
-    finger's ``kind`` reading reaches the threshold (m or N)."""
+def contact_condition(instruction: Instruction, args: Args) -> Contact:
+    """A contact instruction's condition: it holds when the finger's ``kind`` reading
+    reaches the threshold (m or N)."""
     if instruction.condition is None:
         raise ValueError(f"{instruction.name} has no contact condition")
     finger, threshold = args["finger"], args["threshold"]
     assert isinstance(finger, int) and isinstance(threshold, float)
-    return instruction.condition, finger, threshold
+    return Contact(instruction.condition, finger, threshold)

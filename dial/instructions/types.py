@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
-from typing import Literal
+from typing import Literal, NamedTuple
 
 from dial.errors import shorten
 from dial.units import Dimension, UnitError, expected, format_quantity, parse_number, parse_quantity
@@ -17,7 +17,8 @@ FINGERS: tuple[str, ...] = ("index", "middle", "ring", "thumb")
 ARM = "arm"
 EFFECTORS: tuple[str, ...] = (ARM, *FINGERS)
 ALL_JOINTS = 0xFFFF
-CONTACT_KINDS: tuple[str, ...] = ("tactile", "force", "position")
+ContactKind = Literal["tactile", "force", "position"]
+CONTACT_KINDS: tuple[ContactKind, ...] = ("tactile", "force", "position")
 # Threshold dimension and default of each contact kind (SI).
 CONTACT_THRESHOLDS: dict[str, tuple[Dimension, str, float]] = {
     "tactile": ("length", "mm", 0.0001),  # taxel penetration depth
@@ -25,6 +26,16 @@ CONTACT_THRESHOLDS: dict[str, tuple[Dimension, str, float]] = {
     "position": ("length", "mm", 0.003),
 }
 NameKind = Literal["pose", "location", "program", "set", "object"]
+
+
+class Contact(NamedTuple):
+    """A contact condition: it holds when finger ``finger``'s ``kind`` reading reaches
+    ``threshold`` (m for tactile and position, N for force). See
+    :func:`dial.robot.contact.contact_reading`."""
+
+    kind: ContactKind
+    finger: int
+    threshold: float
 
 
 class ParamError(ValueError):

@@ -12,13 +12,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from dial.backend.snapshot import Snapshot
 from dial.instructions.types import FINGERS
 from dial.parser.script import EventDef
 from dial.preview.motions import PreviewPuma
 from dial.preview.scene import Scene
 from dial.primitives.arm import ArmMotion
 from dial.primitives.hand import FingerMove, HandPose
+from dial.robot.snapshot import Snapshot
 from dial.scene.world import JOINTS
 from dial.scheduler.types import Primitive
 
@@ -54,7 +54,7 @@ def finished(scene: Scene, prim: Primitive[Snapshot]) -> list[str]:
 def _arm(scene: Scene, prim: ArmMotion) -> list[str]:
     out = list(prim.problems) if isinstance(prim, PreviewPuma) else []
     labels = prim.labels if isinstance(prim, PreviewPuma) else ["the arm_move"] * len(prim.segments)
-    ranges = scene.robot.arm_range
+    ranges = scene.robot.view.arm_range
     ik = scene.ctx.arm_ik
     for seg, label in zip(prim.segments, labels, strict=True):
         q = seg.waypoints
@@ -80,7 +80,7 @@ def _arm(scene: Scene, prim: ArmMotion) -> list[str]:
 
 def _pose(scene: Scene, prim: HandPose, name: str) -> list[str]:
     out = []
-    ranges = scene.robot.hand_range
+    ranges = scene.robot.view.hand_range
     for k in range(16):
         if not prim.mask >> k & 1:
             continue

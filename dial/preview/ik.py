@@ -27,8 +27,8 @@ from dial.backend.ik import (
     ArmIK,
     FingerIK,
 )
-from dial.backend.memo import make_key
-from dial.backend.snapshot import FloatArray
+from dial.robot.memo import memo_key
+from dial.robot.snapshot import FloatArray
 
 LEAN_ITERATIONS = 30  # per start of LeanArmIK.solve, before it leaves one to mink
 
@@ -80,7 +80,7 @@ class LeanArmIK(ArmIK):
         self, pos: FloatArray, rot: FloatArray, arm_q: FloatArray, iterations: int = 2
     ) -> FloatArray:
         """:meth:`ArmIK.track`, the lean way."""
-        key = make_key(f"{self.MEMO}-track", pos, rot, arm_q, iterations)
+        key = memo_key(f"{self.MEMO}-track", pos, rot, arm_q, iterations)
         known = self.memo.get(key)
         if isinstance(known, np.ndarray):
             return known.copy()

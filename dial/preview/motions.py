@@ -165,7 +165,7 @@ def grasp(scene: Scene, event: EventDef, check: Check) -> Report:
     joints = [k for k in range(16) if jmask >> k & 1]
     fingers = sorted({k // 4 for k in joints})
     watched = {k // 4 for k in range(16) if tmask >> k & 1} or set(fingers)
-    upper = scene.robot.hand_range[:, 1]
+    upper = scene.robot.view.hand_range[:, 1]
     target = scene.robot.hand_target
     stopped: dict[int, set[int]] = {}
     while True:

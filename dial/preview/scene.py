@@ -18,10 +18,10 @@ import numpy as np
 from dial.backend.driver import MujocoRobot
 from dial.backend.ik import ArmIK
 from dial.backend.model import ARM_HOME, load_model, load_untextured, scene_bodies
-from dial.backend.snapshot import FloatArray
 from dial.instructions.types import FINGERS
 from dial.preview.ik import FingerIKOnDemand, LeanArmIK
 from dial.primitives import Context
+from dial.robot.snapshot import FloatArray
 from dial.scene.world import World
 from dial.teach.contacts import FIXED_DEPTH, OBJECT_DEPTH, Parts
 from dial.teach.sim import home_pose
@@ -104,7 +104,7 @@ class Scene:
         what = "the start pose (location 'home')"
         home = ArmIK(ik.model).solve(pos, rot, np.array(ARM_HOME), what)
         robot.arm_target = home
-        self.ctx = Context(robot, world, believed, ik, FingerIKOnDemand(ik.model))
+        self.ctx = Context(robot, robot.view, world, believed, ik, FingerIKOnDemand(ik.model))
         self.parts = parts = Parts.of(model, robot.index)
         names = [model.body(b).name for b in range(model.nbody)]
         group = np.where(parts.arm, ARM, np.where(parts.robot, PALM, -1))
@@ -119,8 +119,8 @@ class Scene:
         self.held: tuple[Held, ...] = ()
         self._released: tuple[bytes, tuple[Held, ...]] = (b"", ())  # hand and grips last let go
         self._carried: tuple[tuple[Held, ...], list[bool]] = ((), [])
-        arm_lo, arm_hi = robot.arm_range.T.copy()
-        hand_lo, hand_hi = robot.hand_range.T.copy()
+        arm_lo, arm_hi = robot.view.arm_range.T.copy()
+        hand_lo, hand_hi = robot.view.hand_range.T.copy()
         self._limits = (arm_lo, arm_hi, hand_lo, hand_hi)
         self._qpos, self._tool_xpos = data.qpos, data.site_xpos[robot.index.tool_site]  # views
         self._hand = b""  # the hand set-points in qpos

@@ -22,7 +22,6 @@ from pathlib import Path
 import numpy as np
 
 from dial.backend.driver import CONTROL_PERIOD
-from dial.backend.snapshot import FloatArray, Snapshot
 from dial.errors import DialError
 from dial.parser.ast import Condition
 from dial.parser.script import EventDef, Run, Script, Step, TBlock, TCall, TIf, TOn, TRepeat, Watch
@@ -33,7 +32,9 @@ from dial.preview.report import Counts, Problems
 from dial.preview.scene import Hit, Scene, State, finger_group
 from dial.primitives import CLASSES
 from dial.primitives.arm import ArmMotion
-from dial.scheduler.types import Course, Now, Outcome, Primitive, RunInfo
+from dial.robot.protocol import Course
+from dial.robot.snapshot import FloatArray, Snapshot
+from dial.scheduler.types import Now, Outcome, Primitive, RunInfo
 
 ARM_STEP = np.radians(0.25)  # rad of any arm joint between two checks of a moving pose
 HAND_STEP = np.radians(1.0)  # rad of any hand joint

@@ -9,12 +9,12 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from dial.backend.snapshot import Snapshot
 from dial.primitives.arm import ArmMove, PumaCommand
 from dial.primitives.context import Context
 from dial.primitives.guarded import GuardedMove
 from dial.primitives.hand import FingerMove, GraspForce, HandPose, Limp
 from dial.primitives.sensing import ContactWait, Fit, Get, Locate, RecordContact
+from dial.robot.snapshot import Snapshot
 from dial.scheduler.types import Ended, Primitive, PrimitiveFactory, RunInfo, Sensor
 
 Made = Primitive[Snapshot] | Sensor[Snapshot]

@@ -19,13 +19,14 @@ from functools import cached_property
 
 import numpy as np
 
-from dial.backend.ik import recall, remember
-from dial.backend.slots import still
-from dial.backend.snapshot import FloatArray, Snapshot
 from dial.geometry import Slerp, rpy_matrix, smooth, smooth_array
 from dial.primitives.context import Context, RobotPrimitive
+from dial.robot.memo import recall, remember
+from dial.robot.protocol import Course
+from dial.robot.slots import still
+from dial.robot.snapshot import FloatArray, Snapshot
 from dial.scene.valii import Appro, Depart, Drive, Move, Statement
-from dial.scheduler.types import DONE, Course, Ended, Now, Outcome, RunInfo
+from dial.scheduler.types import DONE, Ended, Now, Outcome, RunInfo
 
 JOINT_SPEED = 1.0  # rad/s: nominal, only to share a run's time among its segments
 LINEAR_SPEED = 0.25  # m/s
@@ -145,7 +146,7 @@ class Planner:
         """DRIVE: one joint by an angle, stopped at the joint's limit with a warning."""
         q1 = self.q.copy()
         j = st.joint - 1
-        lo, hi = self.ctx.robot.arm_range[j]
+        lo, hi = self.ctx.view.arm_range[j]
         goal = q1[j] + st.angle
         q1[j] = min(hi, max(lo, goal))
         if q1[j] != goal:

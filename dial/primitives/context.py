@@ -1,48 +1,42 @@
-"""What every primitive shares: the robot, the world model, IK and the run's results."""
+"""What every primitive shares: the robot's seam, the world model, IK and the run's results.
+
+Primitives read their snapshot and the read-only :class:`~dial.robot.view.RobotView`, and
+write through their :class:`~dial.robot.slots.Slots`; they never see the physics or the
+driver (:mod:`dial.robot.protocol`).
+"""
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from dial.backend.driver import MujocoRobot
-from dial.backend.ik import ArmIK, FingerIK
-from dial.backend.slots import Slots
-from dial.backend.snapshot import FloatArray, Snapshot
 from dial.geometry import Pose, location_pose
+from dial.robot.protocol import ArmKinematics, Commanded, FingerKinematics
+from dial.robot.slots import Slots
+from dial.robot.snapshot import Snapshot, Touch
+from dial.robot.view import RobotView
 from dial.scene.world import World
 from dial.scheduler.types import Ended, Outcome, Primitive, RunInfo
-
-
-@dataclass(frozen=True)
-class StopContact:
-    """Where a finger touched when a guarded move stopped on its contact (world m).
-
-    ``tactile``: the taxel centroid, None when the array felt nothing (the contact was on
-    the cap or a phalanx); ``link``: the contact point of the finger's links, None when they
-    touched nothing outside the robot. See :mod:`dial.backend.locate`.
-    """
-
-    tactile: FloatArray | None
-    link: FloatArray | None
 
 
 @dataclass
 class Context:
     """Shared by the primitives of one run.
 
-    ``believed`` holds each object's pose as the world model believes it
-    (position (3,), rotation (3, 3)); with ``--perturb`` the true pose in the
-    physics differs, and only sensing can make up the difference.
+    ``robot``: what their slots write (set-points, limp joints, guards); ``view``: what the
+    robot is (joint ranges, fingers). ``believed`` holds each object's pose as the world
+    model believes it (position (3,), rotation (3, 3)); with ``--perturb`` the true pose in
+    the physics differs, and only sensing can make up the difference.
     """
 
-    robot: MujocoRobot
+    robot: Commanded
+    view: RobotView
     world: World
     believed: dict[str, Pose]
-    arm_ik: ArmIK = field(default_factory=ArmIK)
-    finger_ik: FingerIK = field(default_factory=FingerIK)
+    arm_ik: ArmKinematics
+    finger_ik: FingerKinematics
     point_sets: dict[str, list[list[float]]] = field(default_factory=dict)
     # finger -> where it touched when the latest guarded move sensing it stopped on contact
-    stops: dict[int, StopContact] = field(default_factory=dict)
+    stops: dict[int, Touch] = field(default_factory=dict)
     results: dict[str, dict[str, object]] = field(default_factory=dict)
 
     def location(self, name: str) -> Pose:

@@ -15,9 +15,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from dial.backend.snapshot import FloatArray, Snapshot
 from dial.instructions.types import FINGERS
-from dial.primitives.context import Context, RobotPrimitive, StopContact, done, missed
+from dial.primitives.context import Context, RobotPrimitive, done, missed
+from dial.robot.snapshot import FloatArray, Snapshot
 from dial.scheduler.types import Ended, Now, RunInfo
 
 
@@ -62,7 +62,7 @@ class GuardedMove(RobotPrimitive):
         trip = snapshot.trips.get(self.guard)
         travel = min(self.speed * (now.elapsed - self.info.period), self.length)
         if trip is not None:
-            self.ctx.stops[trip.finger] = StopContact(trip.tactile, trip.link)
+            self.ctx.stops[trip.finger] = trip.touch
             if self.press > 0.0:  # the driver froze the effector at contact: lean in a little
                 if self.finger is None:
                     pos = self.ctx.arm_ik.fk(snapshot.arm_q)[0]

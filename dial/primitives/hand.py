@@ -6,11 +6,12 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from dial.backend.slots import still
-from dial.backend.snapshot import FloatArray, Snapshot
 from dial.geometry import smooth, smooth_array
 from dial.primitives.context import Context, RobotPrimitive, done, missed
-from dial.scheduler.types import Course, Ended, Now, RunInfo
+from dial.robot.protocol import Course
+from dial.robot.slots import still
+from dial.robot.snapshot import FloatArray, Snapshot
+from dial.scheduler.types import Ended, Now, RunInfo
 
 
 def _bits(mask: int) -> list[int]:
@@ -67,7 +68,7 @@ class GraspForce(RobotPrimitive):
         self.jbits, self.tbits = _bits(self.jmask), _bits(self.tmask)
         self.monitored = {k // 4 for k in self.tbits} or set(self.fingers)
         # The set-points as Python floats: a few joints a period, cheaper than numpy's calls.
-        self.q, self.limits = self.target.tolist(), self.ctx.robot.hand_range[:, 1].tolist()
+        self.q, self.limits = self.target.tolist(), self.ctx.view.hand_range[:, 1].tolist()
         self.closing = list(self.jbits)  # the joints of the fingers not stopped yet
 
     def step(self, snapshot: Snapshot, now: Now) -> Ended | None:

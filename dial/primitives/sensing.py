@@ -4,12 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from dial.backend.contact import contact_reading
-from dial.backend.locate import finger_bodies, link_point, tactile_point
-from dial.backend.snapshot import FloatArray, Snapshot
 from dial.instructions.catalogue import contact_condition
 from dial.instructions.types import FINGERS
 from dial.primitives.context import Context, RobotPrimitive, done, missed
+from dial.robot.contact import contact_reading
+from dial.robot.snapshot import FloatArray, Snapshot
 from dial.scheduler.types import Ended, Now, Outcome, RunInfo
 
 
@@ -97,7 +96,8 @@ class RecordContact:
                 return missed(f"no guarded move stopped on a contact of the {name}")
             point = stop.tactile if self.source == "tactile" else stop.link
         else:
-            point = self._now(snapshot)
+            touch = snapshot.touch(self.finger)
+            point = touch.tactile if self.source == "tactile" else touch.link
         if point is None:
             where = "fingertip array" if self.source == "tactile" else "links"
             when = "at the stop" if self.at == "stop" else "now"
@@ -105,12 +105,6 @@ class RecordContact:
         points = self.ctx.point_sets.setdefault(self.set, [])
         points.append([float(x) for x in point])
         return done(point=point, set=self.set, count=len(points))
-
-    def _now(self, snapshot: Snapshot) -> FloatArray | None:
-        robot = self.ctx.robot
-        if self.source == "tactile":  # a dropped-out array reads 0 in the snapshot
-            return tactile_point(snapshot.tactile[self.finger], robot.taxel_points(self.finger))
-        return link_point(robot.model, robot.data, finger_bodies(robot.model, self.finger))
 
 
 class Locate:

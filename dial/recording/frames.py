@@ -12,9 +12,9 @@ import mujoco
 import numpy as np
 
 from dial.backend.model import RobotIndex
-from dial.backend.snapshot import FloatArray
 from dial.recording.geometry import moving_bodies
 from dial.recording.task import TaskProbe
+from dial.robot.snapshot import FloatArray
 
 RECORD_HZ = 50.0  # frames per second of simulated time in a recording
 

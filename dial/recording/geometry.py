@@ -12,7 +12,7 @@ from dataclasses import dataclass, replace
 import mujoco
 import numpy as np
 
-from dial.backend.snapshot import FloatArray
+from dial.robot.snapshot import FloatArray
 
 SHOWN_GROUPS = 4  # geom groups 0-3 are drawn; 4 and up hold debug sites and markers
 KINDS = {

@@ -34,7 +34,6 @@ import numpy as np
 import rerun as rr
 
 from dial.backend.model import FINGERS
-from dial.backend.snapshot import FloatArray
 from dial.errors import DialError
 from dial.recording import layout
 from dial.recording.frames import Batch
@@ -42,6 +41,7 @@ from dial.recording.geometry import Shape, body_paths, moving_bodies, shapes, su
 from dial.recording.lanes import STATE_COLORS, LanePlan, Lanes, Phase
 from dial.recording.task import Series
 from dial.recording.timeline import describe, when
+from dial.robot.snapshot import FloatArray
 
 APP_ID = "dial"
 TACTILE_MM = 1.0  # the colour scale's top: a firm press is 0.5-1 mm deep

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from dial.backend.snapshot import FloatArray
+from dial.robot.snapshot import FloatArray
 from dial.scene.criteria import Criterion
 from dial.scene.evaluate import reader
 from dial.scene.thread import find_threads

@@ -8,7 +8,7 @@ a synchronous step object, so trio's task order cannot reach a result.
 When every active run is open-loop (:attr:`~dial.scheduler.types.Primitive.open_loop`: its
 set-points depend on its progress alone), the rest of the tick needs no snapshot and no
 step: the loop takes the runs' courses for those periods at once and the robot *coasts*
-through them (:meth:`~dial.scheduler.types.Robot.coast`), stopping early after any period
+through them (:meth:`~dial.robot.protocol.Clocked.coast`), stopping early after any period
 whose report says something. The periods, records and physics are the same as stepping
 them one by one; only the cost differs (see docs/architecture.md).
 """
@@ -23,22 +23,12 @@ import trio
 
 from dial.errors import DialError
 from dial.parser.script import Run, Script
+from dial.robot.protocol import Clocked, Course, Fired, Report
 from dial.scheduler.active import ActiveRun
 from dial.scheduler.position import Hooks, Resume
 from dial.scheduler.records import Records
 from dial.scheduler.signals import StopRequest
-from dial.scheduler.types import (
-    Course,
-    Ended,
-    Fired,
-    Interrupted,
-    Now,
-    Outcome,
-    Report,
-    Robot,
-    RunAborted,
-    S,
-)
+from dial.scheduler.types import Ended, Interrupted, Now, Outcome, RunAborted, S
 
 ABORT_ON = frozenset({Outcome.TIMEOUT, Outcome.ERROR})
 OUTCOME_TEXT = {o: o.value for o in Outcome}  # a dict lookup is cheaper than Enum.value
@@ -58,7 +48,7 @@ class Periods(Generic[S]):
 
     def __init__(
         self,
-        robot: Robot[S],
+        robot: Clocked[S],
         n: int,
         records: Records,
         stop: StopRequest,

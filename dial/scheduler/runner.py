@@ -27,6 +27,7 @@ from dial.parser.script import (
     TResume,
     TRetry,
 )
+from dial.robot.protocol import Clocked
 from dial.scheduler.log import EventLog
 from dial.scheduler.position import Frame, Hooks, Path, Resume
 from dial.scheduler.records import Records
@@ -36,7 +37,6 @@ from dial.scheduler.types import (
     Interrupted,
     Outcome,
     PrimitiveFactory,
-    Robot,
     RunAborted,
     S,
     periods_per_tick,
@@ -68,7 +68,7 @@ class Runner(Generic[S]):
 
     def __init__(
         self,
-        robot: Robot[S],
+        robot: Clocked[S],
         factory: PrimitiveFactory[S],
         tick: float,
         log: EventLog | None = None,

@@ -13,24 +13,14 @@ from dataclasses import dataclass
 from typing import NamedTuple, cast
 
 from dial.errors import DialError
+from dial.instructions.catalogue import contact_condition
 from dial.parser.script import Run, Script, TBlock, TOn, Watch
+from dial.robot.protocol import Clocked, Course, Fired, Monitor
 from dial.scheduler.active import ActiveRun, RunPlan
 from dial.scheduler.periods import ABORT_ON, Observe, Periods, Progress
 from dial.scheduler.records import Records
 from dial.scheduler.signals import StopRequest
-from dial.scheduler.types import (
-    Course,
-    Ended,
-    Fired,
-    Monitor,
-    Outcome,
-    Primitive,
-    PrimitiveFactory,
-    Robot,
-    RunInfo,
-    S,
-    Sensor,
-)
+from dial.scheduler.types import Ended, Outcome, Primitive, PrimitiveFactory, RunInfo, S, Sensor
 
 __all__ = ["Observe", "Preempted", "Progress", "TickLoop"]
 
@@ -56,7 +46,7 @@ class TickLoop(Periods[S]):
 
     def __init__(
         self,
-        robot: Robot[S],
+        robot: Clocked[S],
         factory: PrimitiveFactory[S],
         n: int,
         records: Records,
@@ -85,7 +75,7 @@ class TickLoop(Periods[S]):
                     await self.hooks.before_tick(self.tick, script, plan.starts.get(k, ()))
                     self._raise_pending()  # a signal while paused
                 for watch in plan.watch_from.get(k, ()):
-                    self._arm(script, block, watch, monitors)
+                    self._watch(script, block, watch, monitors)
                 for run in plan.starts.get(k, ()):
                     self._start(script, run)
                 self._raise_pending()
@@ -108,12 +98,12 @@ class TickLoop(Periods[S]):
                         return await self._preempted(script, block, fired, monitors, k, t0, stretch)
                     stretching = any(a.info.run.exec_end == k for a in self.active)
                 for watch in plan.watch_to.get(k, ()):
-                    self._disarm(monitors, watch)
+                    self._unwatch(monitors, watch)
                 self._tick_done(k, t0, stretch, preempted=False)
             return None
         finally:
             for key in monitors:
-                self.robot.disarm(key)
+                self.robot.unwatch(key)
 
     def _quiet(self, plan: _Plan, k: int, length: int) -> int:
         """How many ticks after tick ``k`` can be coasted along with it: while no run starts
@@ -234,18 +224,19 @@ class TickLoop(Periods[S]):
         return stretching
 
     # -- monitors and preemption (DESIGN 2.7) -------------------------------------------------
-    def _arm(
+    def _watch(
         self, script: Script, block: TBlock, watch: Watch, monitors: dict[int, tuple[int, Watch]]
     ) -> None:
         event = script.events[watch.event]
         for index, on in enumerate(block.reactions):
             if on.condition.event == watch.event:
-                key = self.robot.arm(Monitor(event, on.condition.negated))
+                contact = contact_condition(event.instruction, event.args)
+                key = self.robot.watch(Monitor(event.name, contact, on.condition.negated))
                 monitors[key] = (index, watch)
 
-    def _disarm(self, monitors: dict[int, tuple[int, Watch]], watch: Watch) -> None:
+    def _unwatch(self, monitors: dict[int, tuple[int, Watch]], watch: Watch) -> None:
         for key in [k for k, (_, w) in monitors.items() if w is watch]:
-            self.robot.disarm(key)
+            self.robot.unwatch(key)
             del monitors[key]
 
     async def _preempted(

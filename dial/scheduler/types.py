@@ -1,8 +1,8 @@
 """The contract between the runner, the primitives and the robot.
 
-The runner knows nothing of MuJoCo: it drives any :class:`Robot` over a snapshot type
-``S`` of the robot's choosing, and builds a :class:`Primitive` (or a :class:`Sensor`, for
-zero-length sensing) per run through a :data:`PrimitiveFactory`.
+The runner knows nothing of MuJoCo: it drives a robot's :class:`~dial.robot.protocol.Clocked`
+face over a snapshot type ``S`` of the robot's choosing, and builds a :class:`Primitive` (or
+a :class:`Sensor`, for zero-length sensing) per run through a :data:`PrimitiveFactory`.
 """
 
 from __future__ import annotations
@@ -16,10 +16,9 @@ from typing import Generic, NamedTuple, Protocol, TypeVar
 
 from dial.errors import DialError
 from dial.parser.script import EventDef, Run
-from dial.scheduler.signals import StopRequest
+from dial.robot.protocol import Course
 
 S = TypeVar("S")
-S_co = TypeVar("S_co", covariant=True)
 S_contra = TypeVar("S_contra", contravariant=True)
 
 # What a run reports for the log: JSON-able values (numbers, strings, lists, arrays).
@@ -75,9 +74,6 @@ class Now(NamedTuple):
     progress: float
     elapsed: float
     stretched: bool
-
-
-Course = Callable[[int], None]  # writes the k-th coasted period's set-points (Primitive.course)
 
 
 class Primitive(ABC, Generic[S_contra]):
@@ -139,103 +135,6 @@ class RunInfo:
 
 
 PrimitiveFactory = Callable[[RunInfo], "Primitive[S] | Sensor[S]"]
-
-
-class Happening(NamedTuple):
-    """Something the robot observed during a period, for the runner to log.
-
-    ``kind`` is the record kind (``contact``, ``thread``, ``warning``); ``fields`` its
-    fields, with the simulated time ``t`` of the physics step where it happened.
-    """
-
-    kind: str
-    fields: Data
-
-
-class Fired(NamedTuple):
-    """A monitor whose condition held at a physics step of the period."""
-
-    key: int
-    time: float
-    step: int
-
-
-class Report(NamedTuple):
-    """What happened during one control period, when anything did (else ``advance`` -> None).
-
-    ``fault``: an engine-owned safety monitor tripped (joint or tension limit, non-finite
-    state); the runner aborts. ``fired``: monitors, in the order they were armed.
-    """
-
-    fault: str | None = None
-    happenings: tuple[Happening, ...] = ()
-    fired: tuple[Fired, ...] = ()
-
-
-class Monitor(NamedTuple):
-    """A live condition the robot tests at every physics step while it is armed.
-
-    ``event`` is the watched sensing event; the robot fires when its condition holds
-    (``negated``: when it does not).
-    """
-
-    event: EventDef
-    negated: bool
-
-
-class Robot(Protocol[S_co]):
-    """What the runner needs of a robot backend. Every call is synchronous."""
-
-    @property
-    def period(self) -> float:
-        """The control period in seconds."""
-        ...
-
-    def snapshot(self) -> S_co:
-        """An immutable view of the sensors for this control period."""
-        ...
-
-    def advance(self) -> Report | None:
-        """Apply the command slots and simulate one control period."""
-        ...
-
-    def coast(
-        self, writes: Sequence[Course], periods: int, stop: StopRequest
-    ) -> tuple[int, Report | None]:
-        """``advance`` up to ``periods`` times, each after ``write(k)`` of every course for
-        the k-th period; return after a period that reports anything, or once ``stop`` has a
-        signal: (periods taken, that report or None)."""
-        ...
-
-    def hold_all(self) -> None:
-        """Freeze every effector where it is measured now (abort, interrupt)."""
-        ...
-
-    def hold(self, effectors: frozenset[str]) -> None:
-        """Freeze these effectors where they are measured now (preemption)."""
-        ...
-
-    def arm(self, monitor: Monitor) -> int:
-        """Start testing a monitor every physics step; returns its key."""
-        ...
-
-    def disarm(self, key: int) -> None:
-        """Stop testing a monitor."""
-        ...
-
-
-def advance_through(
-    robot: Robot[object], writes: Sequence[Course], periods: int, stop: StopRequest
-) -> tuple[int, Report | None]:
-    """:meth:`Robot.coast` done with :meth:`Robot.advance`, one period after another: what a
-    robot with no faster way of its own does."""
-    for k in range(periods):
-        for write in writes:
-            write(k)
-        report = robot.advance()
-        if report is not None or stop.signal is not None:
-            return k + 1, report
-    return periods, None
 
 
 class RunAborted(DialError):

@@ -11,9 +11,9 @@ import math
 from collections.abc import Mapping
 from dataclasses import fields
 
-from dial.backend.snapshot import FloatArray
 from dial.geometry import location_pose
 from dial.instructions.types import FINGERS
+from dial.robot.snapshot import FloatArray
 from dial.scene.criteria import Criterion
 from dial.scene.valii import Appro, Depart, Drive, Move, Statement
 from dial.scene.world import JOINTS, HandPose, World

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 
-from dial.backend.snapshot import FloatArray
 from dial.geometry import matrix_rpy
+from dial.robot.snapshot import FloatArray
 
 __all__ = ["deg_text", "fixed", "half_turn", "matrix_rpy", "mm_text", "relative"]
 

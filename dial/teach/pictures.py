@@ -16,11 +16,11 @@ from typing import Any
 
 import numpy as np
 
-from dial.backend.snapshot import FloatArray
 from dial.errors import DialError
 from dial.geometry import location_pose
 from dial.recording.geometry import Camera, task_camera
 from dial.recording.video import Renderer
+from dial.robot.snapshot import FloatArray
 from dial.teach.sim import Sim
 
 WIDTH, HEIGHT = 1280, 960  # --picture

@@ -7,8 +7,8 @@ from collections.abc import Iterable
 
 import numpy as np
 
-from dial.backend.snapshot import FloatArray
 from dial.instructions.types import FINGERS
+from dial.robot.snapshot import FloatArray
 from dial.scene.world import JOINTS, World
 from dial.teach.contacts import touches
 from dial.teach.frames import deg_text, fixed, matrix_rpy, mm_text, relative

@@ -18,11 +18,11 @@ from types import MappingProxyType
 import numpy as np
 
 from dial.backend.ik import IKError
-from dial.backend.snapshot import FloatArray
 from dial.errors import DialError
 from dial.geometry import rpy_matrix
 from dial.instructions.types import FINGERS
 from dial.primitives.arm import Planner
+from dial.robot.snapshot import FloatArray
 from dial.scene.valii import Appro, Depart, Drive, Move, Statement
 from dial.scene.world import JOINTS, World
 from dial.teach import report

@@ -16,12 +16,12 @@ import mujoco
 import numpy as np
 
 from dial.backend.driver import MujocoRobot
-from dial.backend.ik import ArmIK
+from dial.backend.ik import ArmIK, FingerIK
 from dial.backend.model import ARM_HOME, RobotIndex, hand_ctrl, load_model
-from dial.backend.snapshot import FloatArray
 from dial.geometry import location_pose, rpy_matrix, smooth
 from dial.primitives.arm import Segment
 from dial.primitives.context import Context
+from dial.robot.snapshot import FloatArray
 from dial.scene.thread import find_threads, set_turns
 from dial.scene.world import World
 from dial.teach.contacts import Parts, collision
@@ -101,9 +101,10 @@ class Sim:
         self._apply()
         mujoco.mj_forward(model, data)
         # The planner of `dial run` reads the world, the IK and the joint ranges from here.
-        self.ctx = Context(MujocoRobot(model, data), world, believed, self.ik)
-        self.arm_range = self.ctx.robot.arm_range  # (6, 2) rad
-        self.hand_range = self.ctx.robot.hand_range  # (16, 2) rad, mask order
+        robot = MujocoRobot(model, data)
+        self.ctx = Context(robot, robot.view, world, believed, self.ik, FingerIK())
+        self.arm_range = robot.view.arm_range  # (6, 2) rad
+        self.hand_range = robot.view.hand_range  # (16, 2) rad, mask order
         if settle:
             self.run_for(START_SETTLE_S)
 

@@ -21,22 +21,10 @@ import trio.testing
 from dial.instructions.types import EFFECTORS
 from dial.parser.check import check_text
 from dial.parser.script import Script
+from dial.robot.protocol import Course, Fired, Monitor, Report, StopFlag, advance_through
 from dial.scheduler.log import EventLog, Record
 from dial.scheduler.runner import Runner, RunSummary
-from dial.scheduler.signals import StopRequest
-from dial.scheduler.types import (
-    Course,
-    Ended,
-    Fired,
-    Monitor,
-    Now,
-    Outcome,
-    Primitive,
-    Report,
-    RunInfo,
-    Sensor,
-    advance_through,
-)
+from dial.scheduler.types import Ended, Now, Outcome, Primitive, RunInfo, Sensor
 
 
 class FakeSnapshot(NamedTuple):
@@ -66,7 +54,7 @@ class FakeRobot:
         self.fault_at = dict(fault_at or {})
         self.conditions = dict(holds or {})
         self.monitors: dict[int, Monitor] = {}
-        self.armed: list[tuple[int, str, bool]] = []  # (period, event, negated), as armed
+        self.watched: list[tuple[int, str, bool]] = []  # (period, event, negated), as watched
         self._keys = itertools.count(1)
         self.stops: list[str] = []  # events whose run was stopped, in order
         self.coasts: list[tuple[int, int]] = []  # each coast's first period and length asked
@@ -87,12 +75,12 @@ class FakeRobot:
         fired = tuple(
             Fired(key, periods * self._period, periods)
             for key, m in self.monitors.items()
-            if (periods in self.conditions.get(m.event.name, ())) != m.negated
+            if (periods in self.conditions.get(m.event, ())) != m.negated
         )
         return Report(fault, (), fired) if fault is not None or fired else None
 
     def coast(
-        self, writes: Sequence[Course], periods: int, stop: StopRequest
+        self, writes: Sequence[Course], periods: int, stop: StopFlag
     ) -> tuple[int, Report | None]:
         self.coasts.append((self.periods + 1, periods))
         return advance_through(self, writes, periods, stop)
@@ -103,13 +91,13 @@ class FakeRobot:
     def hold(self, effectors: frozenset[str]) -> None:
         self.holds_at.append((self.periods, effectors))
 
-    def arm(self, monitor: Monitor) -> int:
+    def watch(self, monitor: Monitor) -> int:
         key = next(self._keys)
         self.monitors[key] = monitor
-        self.armed.append((self.periods + 1, monitor.event.name, monitor.negated))
+        self.watched.append((self.periods + 1, monitor.event, monitor.negated))
         return key
 
-    def disarm(self, key: int) -> None:
+    def unwatch(self, key: int) -> None:
         self.monitors.pop(key, None)
 
 

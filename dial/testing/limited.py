@@ -21,9 +21,9 @@ import trio.testing
 from dial.instructions.types import EFFECTORS
 from dial.parser.check import load
 from dial.parser.script import Script
+from dial.robot.protocol import Report
 from dial.scheduler.log import EventLog
 from dial.scheduler.runner import Runner, RunSummary
-from dial.scheduler.types import Report
 from dial.testing.fake import FakeFactory, FakeRobot
 from dial.tune.grid import Trial
 from dial.tune.trial import RunReport

@@ -20,9 +20,9 @@ from dial.disturb import parse_disturbance
 from dial.engine import RunOptions, run
 from dial.parser import load
 from dial.resources import resolve_script
+from dial.robot.protocol import Report
 from dial.scene import load_scene_names
 from dial.scheduler import periods
-from dial.scheduler.types import Report
 
 
 def _run(name: str, **options: object) -> tuple[list[dict[str, object]], list[float]]:

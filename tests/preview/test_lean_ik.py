@@ -11,13 +11,14 @@ import numpy as np
 import pytest
 
 from dial.api import load
-from dial.backend.ik import ArmIK, FingerIK, IKError, forget_solutions
+from dial.backend.ik import ArmIK, FingerIK, IKError
 from dial.backend.model import ARM_HOME, ROBOT_DIR, load_model, load_untextured
-from dial.backend.snapshot import FloatArray
 from dial.geometry import Slerp, rpy_matrix
 from dial.preview import preview
 from dial.preview.ik import FingerIKOnDemand, LeanArmIK, box_qp
 from dial.primitives.arm import Planner
+from dial.robot.memo import forget_solutions
+from dial.robot.snapshot import FloatArray
 
 
 @pytest.fixture(scope="module")

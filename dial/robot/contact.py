@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike
 
-from dial.backend.snapshot import FloatArray
+from dial.robot.snapshot import FloatArray
 
 POSITION_LEVER = 0.1  # m: joint error (rad) to fingertip displacement, about a finger length
 

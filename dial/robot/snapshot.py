@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Protocol
+from typing import NamedTuple, Protocol
 
 import numpy as np
 from numpy.typing import NDArray
@@ -12,21 +12,30 @@ from numpy.typing import NDArray
 FloatArray = NDArray[np.float64]
 
 
+class Touch(NamedTuple):
+    """Where a finger touches (world m): ``tactile``, the depth-weighted centroid of the
+    taxels that feel something, None when its array feels nothing (or has dropped out);
+    ``link``, the deepest contact point of its links with anything outside the robot, None
+    when they touch nothing there. See :mod:`dial.backend.locate`."""
+
+    tactile: FloatArray | None
+    link: FloatArray | None
+
+
+NO_TOUCH = Touch(None, None)
+
+
 @dataclass(frozen=True)
 class Trip:
-    """A guard that fired: when (simulated s, physics step), on what, and the reading.
-
-    ``tactile`` and ``link``: where the finger touched at that physics step (world m, see
-    :mod:`dial.backend.locate`), or None when its array (or its links) touched nothing.
-    """
+    """A guard that fired: when (simulated s, physics step), on what, the reading, and where
+    the finger touched at that physics step."""
 
     time: float
     step: int
     kind: str  # tactile, force or position
     finger: int
     value: float
-    tactile: FloatArray | None = None
-    link: FloatArray | None = None
+    touch: Touch = NO_TOUCH
 
 
 class Sensors(Protocol):
@@ -39,6 +48,10 @@ class Sensors(Protocol):
 
     def read(self, name: str, hand_target: FloatArray) -> FloatArray:
         """A fresh, read-only array for the snapshot field ``name``."""
+        ...
+
+    def touch(self, finger: int) -> Touch:
+        """Where ``finger`` touches now."""
         ...
 
 
@@ -109,6 +122,12 @@ class Snapshot:
         self.time, self.step = time, step
         self.arm_target, self.hand_target = arm_target, hand_target
         self.trips, self.dropped = trips, dropped
+
+    def touch(self, finger: int) -> Touch:
+        """Where ``finger`` touches (world m) in this control period."""
+        if self._sensors.generation != self._generation:
+            raise StaleSnapshotError("snapshot touch read a period late")
+        return self._sensors.touch(finger)
 
 
 def frozen(array: NDArray[np.float64], fresh: bool = False) -> FloatArray:

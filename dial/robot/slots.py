@@ -3,37 +3,17 @@
 from __future__ import annotations
 
 from collections.abc import Iterable
-from typing import Protocol
 
 import numpy as np
 
-from dial.backend.model import IntArray
-from dial.backend.snapshot import FloatArray
 from dial.errors import DialError
 from dial.instructions.types import FINGERS
-from dial.scheduler.types import Course
+from dial.robot.protocol import Commanded, Course, IntArray
+from dial.robot.snapshot import FloatArray
 
 
 class EffectorError(DialError):
     """A primitive wrote to an effector its run does not own (a bug, not a script error)."""
-
-
-class Commanded(Protocol):
-    """What slots write to: the robot's set-points, limp joints and guards."""
-
-    arm_target: FloatArray  # (6,) rad
-    hand_target: FloatArray  # (16,) rad, mask order
-    limp: np.ndarray  # (16,) bool, written through set_limp
-
-    def set_limp(self, joints: IntArray, on: bool) -> None: ...
-
-    def measured_hand(self) -> FloatArray: ...
-
-    def arm_guard(
-        self, effector: str, conditions: Iterable[tuple[str, float]], sense: Iterable[int]
-    ) -> int: ...
-
-    def disarm(self, key: int) -> None: ...
 
 
 def _bits(mask: int) -> list[int]:
@@ -118,7 +98,7 @@ class Slots:
         """Freeze ``effector`` at the physics step where a contact condition holds on a
         ``sense`` finger; returns the guard's key (its trip shows in later snapshots)."""
         self._own(effector)
-        return self.robot.arm_guard(effector, conditions, sense)
+        return self.robot.guard(effector, conditions, sense)
 
     def unguard(self, key: int) -> None:
-        self.robot.disarm(key)
+        self.robot.unguard(key)

@@ -8,10 +8,9 @@ its file in the user's cache folder does, so that a script run again starts with
 loading mink, qpsolvers or SciPy (docs/architecture.md, "Start-up").
 
 The file is named by a **fingerprint** of everything a solution depends on besides its
-inputs: the compiled IK model (its MJB bytes), the source of the solver's modules, the
-versions of MuJoCo, numpy and Python, the installed files of mink, qpsolvers and daqp (their
-sizes and modification times), and the machine. Any change gives another file, so an entry
-is never read where it could differ from a fresh solve. A process writes the file at exit
+inputs (:mod:`dial.backend.fingerprint`: the compiled IK model, the solver's code, the
+versions and files of what it runs on, the machine). Any change gives another file, so an
+entry is never read where it could differ from a fresh solve. A process writes the file at exit
 only if it solved something new (its own entries last; the oldest beyond :data:`MAX_SAVED`
 dropped), by renaming a whole new file over it. The folder is ``$DIAL_CACHE``, else the
 platform's user cache folder; ``DIAL_CACHE=off`` turns the file off. A folder that is
@@ -23,33 +22,26 @@ stores its own bytecode cache.
 from __future__ import annotations
 
 import atexit
-import hashlib
 import marshal
 import os
 import sys
 import tempfile
 import time
 from collections import OrderedDict
-from collections.abc import Iterable
 from contextlib import suppress
-from functools import cache
-from importlib.util import find_spec
 from pathlib import Path
 
-import mujoco
 import numpy as np
 
-FORMAT = b"dial-ik-memo-1"
 MAX_SAVED = 20_000  # entries in one file (about 5 MB; read in about 10 ms)
 STALE_DAYS = 30  # files of other fingerprints untouched this long are removed on a write
-_SOLVER_PACKAGES = ("mink", "qpsolvers", "daqp")
 _OFF = ("", "0", "off", "no", "none", "false")
 
 Key = tuple[object, ...]
 Stored = bytes | tuple[float, ...]  # an array's float64 bytes, or a failed solve's figures
 
 
-def make_key(kind: str, *parts: object) -> Key:
+def memo_key(kind: str, *parts: object) -> Key:
     """The key of a result computed from these exact inputs (arrays by their bytes)."""
     return (
         kind,
@@ -69,7 +61,7 @@ class Memo:
 
     SIZE = 50_000
 
-    def __init__(self, fingerprint: str | None) -> None:
+    def __init__(self, fingerprint: str | None = None) -> None:
         self.fingerprint = fingerprint
         self._values: OrderedDict[Key, object] = OrderedDict()
         self._disk: dict[Key, Stored] | None = None  # read on the first miss
@@ -191,83 +183,38 @@ def _write(path: Path, data: bytes) -> None:
                 other.unlink()
 
 
-def fingerprint(model: mujoco.MjModel, sources: Iterable[str]) -> str | None:
-    """The name of the memo's file for solvers on ``model`` whose code is in ``sources``;
-    None when the cache is off."""
-    if cache_dir() is None:
-        return None
-    h = hashlib.sha256(_setting(tuple(sorted(sources))))
-    mjb = np.zeros(mujoco.mj_sizeModel(model), dtype=np.uint8)
-    mujoco.mj_saveModel(model, None, mjb)
-    h.update(mjb.tobytes())
-    return h.hexdigest()[:32]
-
-
-@cache
-def _setting(sources: tuple[str, ...]) -> bytes:
-    """What a solution depends on besides its model and inputs, once per process: the
-    format, Python, MuJoCo and numpy, the machine, the solvers' code and packages."""
-    machine = os.uname() if hasattr(os, "uname") else (sys.platform,)
-    parts = [FORMAT, *(s.encode() for s in (sys.version, mujoco.__version__, np.__version__))]
-    parts += [s.encode() for s in machine]
-    parts += [Path(source).read_bytes() for source in sources]
-    parts += [_installed(package).encode() for package in _SOLVER_PACKAGES]
-    return hashlib.sha256(b"\0".join(parts)).digest()
-
-
-def _installed(package: str) -> str:
-    """The installed files of ``package`` by size and modification time (not imported)."""
-    spec = find_spec(package)
-    if spec is None or spec.origin is None:
-        return f"{package}: missing"
-    if not spec.submodule_search_locations:  # a module: its file
-        return _stat(spec.origin)
-    found = []
-    for folder, _, files in os.walk(os.path.dirname(spec.origin)):  # a package: its folder
-        found += [_stat(os.path.join(folder, f)) for f in files if not f.endswith(".pyc")]
-    return "\n".join(sorted(found))
-
-
-def _stat(path: str) -> str:
-    try:
-        st = os.stat(path)
-    except OSError:
-        return f"{path}: missing"
-    return f"{path}:{st.st_size}:{st.st_mtime_ns}"
-
-
 _MEMOS: dict[str | None, Memo] = {}
 _WRITERS: list[Memo] = []
 
 
-def memo_for(model: mujoco.MjModel, sources: Iterable[str]) -> Memo:
-    """The memo of solvers on ``model`` whose code is in ``sources`` (one per fingerprint)."""
-    name = fingerprint(model, sources)
+def memo_for(name: str | None) -> Memo:
+    """The memo kept in the file ``name`` (a fingerprint; None: in this process only), one
+    per name in a process."""
     memo = _MEMOS.get(name)
     if memo is None:
         memo = _MEMOS[name] = Memo(name)
     return memo
 
 
-_LINES = Memo(None)  # results built from solves (a line's waypoints): in this process only
+SOLUTIONS = Memo(None)  # results built from solves (a line's waypoints): this process only
 
 
 def recall(kind: str, *parts: object) -> tuple[Key, object]:
     """The memo's key for a result computed from these exact inputs, and the result if one
     is known (else None): for results built from solves, such as a line's waypoints."""
-    key = make_key(kind, *parts)
-    return key, _LINES.get(key)
+    key = memo_key(kind, *parts)
+    return key, SOLUTIONS.get(key)
 
 
 def remember(key: Key, value: object) -> None:
     """Keep ``value`` under ``key`` (from :func:`recall`)."""
-    _LINES.put(key, value)
+    SOLUTIONS.put(key, value)
 
 
 def forget_solutions() -> None:
     """Empty every memo, and read no file again in this process: the next solves cost what
     they cost in a fresh process without a cache (benchmarks)."""
-    _LINES.clear()
+    SOLUTIONS.clear()
     for memo in _MEMOS.values():
         memo.clear()
 
