@@ -8,6 +8,7 @@ words count one by one, as in the paper's ``"0x0666_0x0222 400"``), or
 from __future__ import annotations
 
 import re
+from dataclasses import fields
 
 from dial.errors import Span
 from dial.parser.ast import Param, Word
@@ -106,8 +107,9 @@ def _general(line: int, code: str, start: int) -> list[Param]:
 def _unquoted(line: int, code: str, start: int) -> list[Param]:
     """:func:`tokenize` of parameters without quotes: each word is a bare word or
     ``key=value`` (the value up to the next space, ``=`` included). Lean, as a 300 KB line
-    of parameters is 75,000 of them (issue 26): spans are made as plain tuples are, without
-    the Python-level ``__new__`` of a named tuple."""
+    of parameters is 75,000 of them (issue 26): spans are made as plain tuples are, and
+    words and parameters by setting their slots (``tests/test_properties.py`` holds this
+    path to :func:`_general`'s results)."""
     params: list[Param] = []
     append, span = params.append, tuple.__new__
     for m in _WORD.finditer(code, start):
@@ -116,7 +118,7 @@ def _unquoted(line: int, code: str, start: int) -> list[Param]:
         eq = text.find("=")
         if eq < 0:
             at = span(Span, (line, begin + 1, end + 1))
-            append(Param(None, (Word(text, at),), False, at))
+            append(_param(None, _word(text, at), at))
             continue
         key = text[:eq]
         if not _KEY.match(key):
@@ -126,6 +128,33 @@ def _unquoted(line: int, code: str, start: int) -> list[Param]:
             )
         if eq == len(text) - 1:
             raise WordError(Span(line, begin + 1, end + 1), f"missing value after '{key}='")
-        word = Word(text[eq + 1 :], span(Span, (line, begin + eq + 2, end + 1)))
-        append(Param(key, (word,), False, span(Span, (line, begin + 1, end + 1))))
+        word = _word(text[eq + 1 :], span(Span, (line, begin + eq + 2, end + 1)))
+        append(_param(key, word, span(Span, (line, begin + 1, end + 1))))
     return params
+
+
+# A Word and an unquoted Param without their dataclass __init__ (a Python frame and a
+# generic setattr per field): their slots are set through the slots' own descriptors.
+assert [f.name for f in fields(Word)] == ["text", "span"]
+assert [f.name for f in fields(Param)] == ["key", "words", "quoted", "span"]
+_NEW = object.__new__
+_TEXT, _SPAN = (Word.__dict__[name].__set__ for name in ("text", "span"))
+_KEY_OF, _WORDS, _QUOTED, _PARAM_SPAN = (
+    Param.__dict__[name].__set__ for name in ("key", "words", "quoted", "span")
+)
+
+
+def _word(text: str, at: Span) -> Word:
+    word: Word = _NEW(Word)
+    _TEXT(word, text)
+    _SPAN(word, at)
+    return word
+
+
+def _param(key: str | None, word: Word, at: Span) -> Param:
+    param: Param = _NEW(Param)
+    _KEY_OF(param, key)
+    _WORDS(param, (word,))
+    _QUOTED(param, False)
+    _PARAM_SPAN(param, at)
+    return param
