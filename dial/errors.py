@@ -100,9 +100,10 @@ class TooManyProblems(Exception):
 def tally(found: int, diags: list[Diagnostic], path: str, line: int, text: str) -> int:
     """``found``, the problems of the file at ``path`` so far, the latest on ``line``. At
     :data:`MAX_PROBLEMS` the check of the file stops: its :class:`Cutoff` joins ``diags``,
-    and :class:`TooManyProblems` is raised."""
+    and :class:`TooManyProblems` is raised (as it is beyond, where the check stopped)."""
     if found >= MAX_PROBLEMS:
-        diags.append(Cutoff.at(path, line, text))
+        if found == MAX_PROBLEMS:
+            diags.append(Cutoff.at(path, line, text))
         raise TooManyProblems
     return found
 

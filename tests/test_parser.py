@@ -7,6 +7,7 @@ from pathlib import Path
 import pytest
 
 from dial.errors import ScriptError, Span
+from dial.instructions.types import Contact
 from dial.parser import TBlock, TCall, TIf, TRepeat, check_text, parse, parse_partial
 from dial.parser.ast import Block, Condition
 from dial.parser.script import TAbort, TOn, TResume, TRetry, Watch
@@ -107,10 +108,11 @@ def test_watched_spans_compile_to_watches_not_runs() -> None:
     block = script.timeline[0]
     assert isinstance(block, TBlock)
     assert [r.event for r in block.runs] == ["down"]
+    touch, held = Contact("tactile", 0, 0.0001), Contact("force", 3, 0.5)
     assert block.watches == (
-        Watch("held", 7, 1, 1),
-        Watch("touch", 6, 3, 4),
-        Watch("touch", 6, 6, 8),
+        Watch("held", 7, 1, 1, held),
+        Watch("touch", 6, 3, 4, touch),
+        Watch("touch", 6, 6, 8, touch),
     )
     assert block.watches[1].span == Span(6, 9, 11)
     assert block.length == 9  # the '~' ticks and the trailing '.' count
@@ -129,7 +131,8 @@ def test_reaction_bodies_compile_with_their_endings() -> None:
     assert isinstance(block, TBlock)
     first, second = block.reactions
     inner, loop, retry = first.body
-    assert isinstance(inner, TBlock) and inner.watches == (Watch("held", 9, 1, 1),)
+    held = Contact("force", 3, 0.5)
+    assert isinstance(inner, TBlock) and inner.watches == (Watch("held", 9, 1, 1, held),)
     assert inner.reactions == (TOn(Condition("held", False), (TResume(11),), 10),)
     assert isinstance(loop, TRepeat) and isinstance(loop.body[1], TIf)
     assert loop.body[1].then == (TAbort("slipped twice", 16),)

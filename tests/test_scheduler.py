@@ -13,8 +13,9 @@ import trio.testing
 from dial.parser import check_text, expand, load
 from dial.scheduler import Outcome
 from dial.scheduler.log import EventLog
+from dial.scheduler.primitive import Ended, Now, Primitive
 from dial.scheduler.runner import Runner
-from dial.scheduler.types import Ended, Now, Primitive, RunInfo
+from dial.scheduler.types import RunInfo
 from dial.testing import Behaviour, FakeFactory, FakeRobot, run_fake
 
 from .conftest import ROOT
@@ -270,12 +271,12 @@ def test_ctrl_c_stops_the_run_at_a_checkpoint_with_the_arm_held(tick: int) -> No
     script = check_text(text, "x.dial")
     assert script is not None
     robot, log = FakeRobot(), EventLog()
-    fake = FakeFactory(robot, {})
 
-    def factory(info: RunInfo) -> Primitive:
-        return _CtrlC() if info.event.name == "pose" else fake(info)
+    class Factory(FakeFactory):
+        def primitive(self, info: RunInfo) -> Primitive:
+            return _CtrlC() if info.event.name == "pose" else super().primitive(info)
 
-    runner = Runner(robot, factory, 0.1, log)
+    runner = Runner(robot, Factory(robot, {}), 0.1, log)
     summary = trio.run(runner.run, script, clock=trio.testing.MockClock(autojump_threshold=0))
     assert summary.interrupted == "SIGINT" and not summary.ok
     assert robot.held

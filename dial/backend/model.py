@@ -43,19 +43,6 @@ IntArray = NDArray[np.intp]
 FloatArray = NDArray[np.float64]
 
 
-def scene_bodies(model: mujoco.MjModel, world: World) -> list[int]:
-    """Bodies a perturbation moves: every free body, and the world file's fixed objects."""
-    named = {
-        int(mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, b)) for b in world.objects.values()
-    }
-    free = {
-        int(model.jnt_bodyid[j])
-        for j in range(model.njnt)
-        if model.jnt_type[j] == mujoco.mjtJoint.mjJNT_FREE
-    }
-    return sorted(named | free)
-
-
 def _robot_files() -> dict[str, bytes]:
     # MJCF resolves nested file names against the top-level file's folder; handing MuJoCo the
     # files of the robot folder by name lets a scene anywhere include utah_hand_puma.xml.
@@ -221,6 +208,19 @@ class RobotIndex:
             moment_arm=float(np.abs(model.wrap_prm[model.tendon_adr[tendon_ids]]).max()),
             tension_limit=float(model.actuator_forcerange[tendons, 1].max()),
         )
+
+
+def scene_bodies(model: mujoco.MjModel, world: World) -> list[int]:
+    """Bodies a perturbation moves: every free body, and the world file's fixed objects."""
+    named = {
+        int(mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, b)) for b in world.objects.values()
+    }
+    free = {
+        int(model.jnt_bodyid[j])
+        for j in range(model.njnt)
+        if model.jnt_type[j] == mujoco.mjtJoint.mjJNT_FREE
+    }
+    return sorted(named | free)
 
 
 def robot_view(model: mujoco.MjModel, index: RobotIndex) -> RobotView:

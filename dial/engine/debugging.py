@@ -12,7 +12,7 @@ from dial.debug.display import ActiveView, PausedView, state_text
 from dial.engine import state
 from dial.engine.observe import Observer
 from dial.parser.script import Script
-from dial.primitives import Context
+from dial.primitives.context import Context
 from dial.scheduler.position import Path as TimelinePath
 from dial.scheduler.runner import Runner
 from dial.scheduler.signals import StopRequest

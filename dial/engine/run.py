@@ -20,12 +20,12 @@ from dial.backend.driver import MujocoRobot
 from dial.disturb import Disturbance, parse_disturbance
 from dial.engine.observe import Observer, StateLog, Watched, describe, fan_out, first_line
 from dial.engine.result import RunResult, measure_criteria
-from dial.engine.setup import prepare
+from dial.engine.setup import Factory, prepare
 from dial.engine.state import RunSettings, Saved
 from dial.errors import DialError, OptionError
 from dial.parser.lanes import LanePlan
 from dial.parser.script import Script
-from dial.primitives import Context, make_factory
+from dial.primitives.context import Context
 from dial.robot.snapshot import Snapshot
 from dial.scheduler.log import EventLog
 from dial.scheduler.position import Resume
@@ -99,7 +99,7 @@ def run(script: Script, options: RunOptions) -> RunResult:
                 begun.append(observer)
             runner = Runner(
                 robot,
-                make_factory(ctx),
+                Factory(ctx),
                 settings.tick,
                 log,
                 progress=options.progress,

@@ -18,12 +18,15 @@ from dial.backend.model import ARM_HOME, RobotIndex, hand_ctrl, load_model, scen
 from dial.disturb import Disturbance
 from dial.geometry import Pose, location_pose, rpy_matrix
 from dial.parser.script import Script
-from dial.primitives import Context
+from dial.primitives.context import Context
+from dial.robot.snapshot import Snapshot
 from dial.scene.of_script import script_world
 from dial.scene.resolve import worlds_dir
 from dial.scene.thread import set_turns
 from dial.scene.world import World
 from dial.scheduler.log import EventLog
+from dial.scheduler.primitive import Primitive, Sensor
+from dial.scheduler.types import RunInfo
 
 SETTLE_S = 0.5  # objects settle on the table before the script starts
 # Where the tool starts when the world file has no "home" location: high above the tables,
@@ -96,3 +99,17 @@ def prepare(
     log.write("scene", scene=world.name, world=where, perturb=shift, seed=seed)
     robot = MujocoRobot(model, data, disturbances=placed)
     return robot, Context(robot, robot.view, world, believed, ik, FingerIK(ik.model))
+
+
+class Factory:
+    """The runner's primitive factory on a robot: each run's primitive or sensor, as its
+    event's record declares it (``Args.primitive``, ``Args.sensor``)."""
+
+    def __init__(self, ctx: Context) -> None:
+        self.ctx = ctx
+
+    def primitive(self, info: RunInfo) -> Primitive[Snapshot]:
+        return info.event.args.primitive(self.ctx, info.allotment)
+
+    def sensor(self, info: RunInfo) -> Sensor[Snapshot]:
+        return info.event.args.sensor(self.ctx)

@@ -28,12 +28,12 @@ import numpy as np
 from dial.backend.driver import MujocoRobot
 from dial.errors import DialError
 from dial.parser.script import Script, Step, TBlock, TCall, TIf, TRepeat, scripts_of
-from dial.primitives import Context
+from dial.primitives.context import Context
 from dial.robot.snapshot import Touch
 from dial.scheduler.position import Frame, Resume
 from dial.scheduler.position import Path as TimelinePath
+from dial.scheduler.primitive import Outcome
 from dial.scheduler.ticks import TickLoop
-from dial.scheduler.types import Outcome
 
 FORMAT, VERSION = "dial-state", 1
 PHYSICS = mujoco.mjtState.mjSTATE_INTEGRATION

@@ -1,10 +1,12 @@
-"""The instruction catalogue: what each instruction takes, commands and how long it runs."""
+"""The instructions: each declared once, in its own module that the catalogue lists."""
 
-from dial.instructions.catalogue import INSTRUCTIONS, Instruction, ParamSpec
+from dial.instructions.base import Args, Instruction, ParamSpec
+from dial.instructions.catalogue import INSTRUCTIONS
 from dial.instructions.scene_names import SceneLoader, SceneNames, SceneNotFoundError
 
 __all__ = [
     "INSTRUCTIONS",
+    "Args",
     "Instruction",
     "ParamSpec",
     "SceneLoader",

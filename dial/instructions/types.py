@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
-from typing import Literal, NamedTuple
+from typing import Generic, Literal, NamedTuple, TypeVar
 
 from dial.errors import shorten
 from dial.units import Dimension, UnitError, expected, format_quantity, parse_number, parse_quantity
@@ -26,6 +26,7 @@ CONTACT_THRESHOLDS: dict[str, tuple[Dimension, str, float]] = {
     "position": ("length", "mm", 0.003),
 }
 NameKind = Literal["pose", "location", "program", "set", "object"]
+T_co = TypeVar("T_co", covariant=True)
 
 
 class Contact(NamedTuple):
@@ -42,17 +43,18 @@ class ParamError(ValueError):
     """A word that is not a valid value for its parameter."""
 
 
-class ParamType:
-    """Base of the parameter types; ``expected`` reads as 'expected <...>'."""
+class ParamType(Generic[T_co]):
+    """Base of the parameter types: each parses a word into a ``T_co``; ``expected`` reads
+    as 'expected <...>'."""
 
     expected: str = "a value"
 
-    def parse(self, text: str) -> object:
+    def parse(self, text: str) -> T_co:
         raise NotImplementedError
 
 
 @dataclass(frozen=True)
-class Quantity(ParamType):
+class Quantity(ParamType[float]):
     dim: Dimension
     unit: str
     lo: float
@@ -79,7 +81,7 @@ class Quantity(ParamType):
 
 
 @dataclass(frozen=True)
-class Integer(ParamType):
+class Integer(ParamType[int]):
     lo: int
     hi: int
 
@@ -117,14 +119,14 @@ def parse_mask(text: str) -> int:
     return value
 
 
-class Mask(ParamType):
+class Mask(ParamType[int]):
     expected = "a 16-bit joint mask (bit 4*finger + joint), e.g. 0x000F"
 
     def parse(self, text: str) -> int:
         return parse_mask(text)
 
 
-class MaskPair(ParamType):
+class MaskPair(ParamType[tuple[int, int]]):
     expected = "JMASK_TMASK: joint mask and tendon mask, e.g. 0x0666_0x0222"
 
     def parse(self, text: str) -> tuple[int, int]:
@@ -140,7 +142,7 @@ class MaskPair(ParamType):
         return jmask, tmask
 
 
-class Finger(ParamType):
+class Finger(ParamType[int]):
     expected = "a finger: index, middle, ring or thumb (or 0-3)"
 
     def parse(self, text: str) -> int:
@@ -152,24 +154,27 @@ class Finger(ParamType):
 
 
 @dataclass(frozen=True)
-class Choice(ParamType):
-    values: tuple[str, ...]
+class Choice(ParamType[T_co]):
+    """One of a few words, each standing for itself (a ``Literal`` of them)."""
+
+    values: tuple[T_co, ...]
 
     @property
     def expected(self) -> str:  # type: ignore[override]
-        return "one of " + ", ".join(self.values)
+        return "one of " + ", ".join(map(str, self.values))
 
-    def parse(self, text: str) -> str:
-        if text not in self.values:
-            raise ParamError(f"expected {self.expected}, got '{text}'")
-        return text
+    def parse(self, text: str) -> T_co:
+        for value in self.values:
+            if value == text:
+                return value
+        raise ParamError(f"expected {self.expected}, got '{text}'")
 
 
 _NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
 
 
 @dataclass(frozen=True)
-class Name(ParamType):
+class Name(ParamType[str]):
     """A name looked up elsewhere: a pose, location, program or object of the scene, or a
     point set. ``anchored``: a location must be relative to an object (``locate``)."""
 
@@ -187,7 +192,7 @@ class Name(ParamType):
 
 
 @dataclass(frozen=True)
-class Names(ParamType):
+class Names(ParamType[tuple[str, ...]]):
     """Comma-separated names of one kind, each at most once (``lid,pitcher``)."""
 
     kind: NameKind
@@ -209,16 +214,17 @@ class Names(ParamType):
         return names
 
 
-class Conditions(ParamType):
+class Conditions(ParamType[tuple[tuple[ContactKind, float], ...]]):
     """``tactile[:0.2mm],force[:1N],position[:3mm]``: contact conditions, any one ends the move."""
 
     expected = "contact conditions KIND[:THRESHOLD],... with KIND tactile, force or position"
 
-    def parse(self, text: str) -> tuple[tuple[str, float], ...]:
-        out: list[tuple[str, float]] = []
+    def parse(self, text: str) -> tuple[tuple[ContactKind, float], ...]:
+        out: list[tuple[ContactKind, float]] = []
         for item in text.split(","):
-            kind, _, threshold = item.partition(":")
-            if kind not in CONTACT_KINDS:
+            written, _, threshold = item.partition(":")
+            kind = next((k for k in CONTACT_KINDS if k == written), None)
+            if kind is None:
                 raise ParamError(f"expected {self.expected}, got '{item}'")
             if any(k == kind for k, _ in out):
                 raise ParamError(f"contact condition '{kind}' is given twice")

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 from difflib import get_close_matches
 
 from dial.errors import Span
-from dial.instructions.catalogue import Instruction, ParamSpec
+from dial.instructions.base import Instruction, ParamSpec
 from dial.instructions.types import ParamError
 from dial.parser.ast import Definition, Word
 
@@ -19,7 +19,7 @@ class Bound:
     spans: dict[str, Span]
 
 
-def _parse(spec: ParamSpec, word: Word, errors: list[tuple[Span, str]]) -> object:
+def _parse(spec: ParamSpec[object], word: Word, errors: list[tuple[Span, str]]) -> object:
     try:
         return spec.type.parse(word.text)
     except ParamError as e:
@@ -52,21 +52,17 @@ def bind(
             )
         else:
             args[spec.name] = spec.default
-    if not errors and instr.validate is not None:
-        message = instr.validate(args)
-        if message:
-            errors.append((defn.instruction_span, message))
     return bound, errors
 
 
 def _positional(
     instr: Instruction, defn: Definition, bound: Bound, errors: list[tuple[Span, str]]
-) -> tuple[ParamSpec, ...] | None:
+) -> tuple[ParamSpec[object], ...] | None:
     """Bind the positional words (after a verb, for verb-style instructions); return the
     specs that apply, or None if the verb is missing or bad."""
     usage = f"usage: {instr.usage}"
     words = [w for p in defn.params if p.key is None for w in p.words]
-    specs: tuple[ParamSpec, ...]
+    specs: tuple[ParamSpec[object], ...]
     if instr.verbs:
         if not words:
             errors.append((defn.instruction_span, f"{instr.name} needs a command; {usage}"))

@@ -16,18 +16,15 @@ from difflib import get_close_matches
 from pathlib import Path
 
 from dial.errors import MAX_PROBLEMS, Diagnostic, ScriptError, Span, TooManyProblems, tally
-from dial.instructions.catalogue import INSTRUCTIONS, Instruction
+from dial.instructions.base import Instruction, Values
+from dial.instructions.catalogue import INSTRUCTIONS, WATCHABLE
 from dial.instructions.scene_names import SceneLoader, SceneNames, SceneNotFoundError
-from dial.instructions.types import EFFECTORS, Name, Names
+from dial.instructions.types import EFFECTORS, Contact, Name, Names
 from dial.parser.ast import Call, Condition, Definition, ExecLine, Program
 from dial.parser.bind import bind
 from dial.parser.compile import compile_body, diagram_events
 from dial.parser.parse import parse_partial
 from dial.parser.script import EventDef, Script
-
-# The instructions whose condition holds or not at each moment, so that a monitor can sense
-# it every control period: the contact conditions (DESIGN 2.7).
-WATCHABLE = tuple(name for name, i in INSTRUCTIONS.items() if i.condition is not None)
 
 
 def _hint(name: str, valid: list[str]) -> str:
@@ -71,8 +68,7 @@ class _Context:
 
 class _Checker:
     def __init__(self, program: Program, source: str, origin: Path, ctx: _Context) -> None:
-        self.program = program
-        self.seen = 0  # the file's problems so far
+        self.program, self.seen = program, 0  # the file's problems so far
         self.ctx = ctx
         self.origin = origin  # the real file, for resolving @call and @scene paths
         self.source = source
@@ -90,7 +86,8 @@ class _Checker:
         self.ctx.diags.append(Diagnostic(self.program.path, span, message, text))
         self.seen = tally(self.seen + 1, self.ctx.diags, self.program.path, span.line, self.source)
 
-    def run(self) -> Script:
+    def run(self, seen: int = 0) -> Script:
+        self.seen = tally(seen, self.ctx.diags, self.program.path, 0, self.source)
         self.load_scene()
         for d in self.program.definitions:
             self.define(d)
@@ -155,11 +152,16 @@ class _Checker:
         if errors:
             self.broken.add(d.event)
             return
+        args = instr.build(Values(bound.args))
+        problem = args.problem()
+        if problem is not None:
+            self.error(d.instruction_span, f"event '{d.event}': {problem}")
+            self.broken.add(d.event)
+            return
         if self.scene is not None and not self.scene_names(d.event, instr, bound.args, bound.spans):
             self.broken.add(d.event)
             return
-        effectors = instr.effectors(bound.args, self.scene)
-        self.events[d.event] = EventDef(d.event, instr, bound.args, effectors, d)
+        self.events[d.event] = EventDef(d.event, instr, args, args.effectors(self.scene), d)
 
     def scene_names(
         self, event: str, instr: Instruction, args: Mapping[str, object], spans: Mapping[str, Span]
@@ -232,7 +234,7 @@ class _Checker:
             )
         return event
 
-    def watched(self, line: ExecLine) -> bool:
+    def watched(self, line: ExecLine) -> Contact | None:
         event = self.events[line.event]
         instr = event.instruction
         if event.effectors or not instr.sensing:
@@ -242,16 +244,16 @@ class _Checker:
                 f"event '{line.event}' cannot be watched: '~' marks a sensing event, and "
                 f"'{line.event}' ({instr.name}) commands {what}",
             )
-            return False
-        if instr.condition is None:
+            return None
+        contact = event.args.contact()
+        if contact is None:
             self.error(
                 line.span_of(*line.watches[0]),
                 f"event '{line.event}' ({instr.name}) cannot be watched: only "
                 f"{', '.join(WATCHABLE[:-1])} and {WATCHABLE[-1]} can, because only a contact "
                 "condition holds or not at each moment",
             )
-            return False
-        return True
+        return contact
 
     def condition(self, cond: Condition | None) -> None:
         if cond is None or cond.event in self.broken:
@@ -320,10 +322,8 @@ def _check(text: str, path: str, origin: Path, ctx: _Context) -> Script:
     program, syntax = parse_partial(text, path, depth=ctx.depth)
     ctx.diags.extend(syntax)
     checker = _Checker(program, text, origin, ctx.entering(origin))
-    checker.seen = len(syntax)  # a parser that stopped left MAX_PROBLEMS and its Cutoff
-    with suppress(TooManyProblems):  # the check of a file stops there, as compilers do
-        if checker.seen < MAX_PROBLEMS:
-            return checker.run()
+    with suppress(TooManyProblems):  # at the file's MAX_PROBLEMS-th problem, as compilers do
+        return checker.run(len(syntax))  # (a parser that stopped there left its Cutoff too)
     return Script(program.path, program, {}, frozenset(), (), None, ctx.scene_override)
 
 

@@ -11,7 +11,7 @@ from operator import attrgetter
 from typing import Protocol
 
 from dial.errors import Span
-from dial.instructions.types import FINGERS
+from dial.instructions.types import FINGERS, Contact
 from dial.parser.ast import (
     Abort,
     Block,
@@ -52,8 +52,9 @@ class Checks(Protocol):
     def event(self, line: ExecLine) -> EventDef | None:
         """The bound event of an execution line, or None (its problem is reported)."""
 
-    def watched(self, line: ExecLine) -> bool:
-        """Whether the watched line's event may be watched (if not, it is reported)."""
+    def watched(self, line: ExecLine) -> Contact | None:
+        """The contact condition of the watched line's event, or None if it cannot be
+        watched (then it is reported)."""
 
     def condition(self, cond: Condition | None) -> None:
         """Check a condition of ``@if`` or ``@repeat``."""
@@ -112,9 +113,10 @@ def compile_block(block: Block, checks: Checks) -> TBlock:
         event = checks.event(line)
         if event is None:
             continue
-        if line.watches and checks.watched(line):
+        contact = checks.watched(line) if line.watches else None
+        if contact is not None:
             watches += (
-                Watch(line.event, line.line, w.start, w.end, line.span_of(w.start, w.end))
+                Watch(line.event, line.line, w.start, w.end, contact, line.span_of(w.start, w.end))
                 for w in line.watches
             )
         name, number, effectors, col = line.event, line.line, event.effectors, line.column

@@ -9,21 +9,23 @@ from __future__ import annotations
 
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
-from typing import Any, Literal
+from typing import Literal
 
 from dial.errors import Span
-from dial.instructions.catalogue import Instruction
+from dial.instructions.base import Args, Instruction
 from dial.instructions.scene_names import SceneNames
+from dial.instructions.types import Contact
 from dial.parser.ast import Condition, Definition, Program
 
 
 @dataclass(frozen=True)
 class EventDef:
-    """A defined event bound to its instruction."""
+    """A defined event bound to its instruction: its typed argument record (SI units; the
+    instruction's module declares it) and the effectors it commands in its scene."""
 
     name: str
     instruction: Instruction
-    args: Mapping[str, Any]  # bound values, SI units
+    args: Args
     effectors: frozenset[str]
     definition: Definition
 
@@ -55,13 +57,14 @@ class Run:
 
 @dataclass(frozen=True)
 class Watch:
-    """A watched span: sensing event ``event`` sensed every control period of block ticks
-    start..end."""
+    """A watched span: sensing event ``event``, whose condition is ``contact``, sensed at
+    every physics step of block ticks start..end."""
 
     event: str
     line: int
     start: int
     end: int
+    contact: Contact
     span: Span = field(default=Span(0, 0, 0), compare=False)
 
 

@@ -10,36 +10,48 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+from typing import Protocol
+
 import numpy as np
 
 from dial.instructions.types import FINGERS
-from dial.parser.script import EventDef
-from dial.preview.motions import PreviewPuma
 from dial.preview.scene import Scene
-from dial.primitives.arm import ArmMotion
+from dial.primitives.arm import Segment
 from dial.primitives.hand import FingerMove, HandPose
-from dial.robot.snapshot import Snapshot
 from dial.scene.world import JOINTS
-from dial.scheduler.types import Primitive
 
 LINE_TOL = 0.002  # m: a straight line whose tool leaves it by more is not followed
 TIP_TOL = 0.003  # m: a fingertip that ends farther from its goal did not get there
 LIMIT_TOL = 1e-6  # rad
 
 
-def started(scene: Scene, prim: Primitive[Snapshot], event: EventDef) -> list[str]:
-    """Problems with a run's plan, as messages."""
-    if isinstance(prim, ArmMotion):
-        return _arm(scene, prim)
-    if isinstance(prim, HandPose):
-        return _pose(scene, prim, str(event.args["pose"]))
-    return []
+class Planned(Protocol):
+    """An arm motion planned: its segments."""
+
+    @property
+    def segments(self) -> Sequence[Segment]: ...
 
 
-def finished(scene: Scene, prim: Primitive[Snapshot]) -> list[str]:
-    """Problems with where a run got, as messages."""
-    if not isinstance(prim, FingerMove):
-        return []
+class Labelled(Planned, Protocol):
+    """An arm motion planned for the preview: its segments, what each follows, and the
+    statements it could not plan."""
+
+    @property
+    def labels(self) -> list[str]: ...
+
+    @property
+    def problems(self) -> Sequence[str]: ...
+
+
+def program_plan(scene: Scene, prim: Labelled) -> list[str]:
+    """Problems with a ``puma_command``'s plan: the statements out of reach, then
+    :func:`arm_plan`'s."""
+    return [*prim.problems, *arm_plan(scene, prim, prim.labels)]
+
+
+def finger_goal(scene: Scene, prim: FingerMove) -> list[str]:
+    """Whether a finger move's fingertip got to its goal."""
     scene.pose()
     goal = prim.tip0 + prim.delta
     off = float(np.linalg.norm(scene.tip(prim.finger) - goal))
@@ -51,9 +63,10 @@ def finished(scene: Scene, prim: Primitive[Snapshot]) -> list[str]:
     ]
 
 
-def _arm(scene: Scene, prim: ArmMotion) -> list[str]:
-    out = list(prim.problems) if isinstance(prim, PreviewPuma) else []
-    labels = prim.labels if isinstance(prim, PreviewPuma) else ["the arm_move"] * len(prim.segments)
+def arm_plan(scene: Scene, prim: Planned, labels: list[str]) -> list[str]:
+    """Problems with an arm motion's segments (each named by its label): a configuration
+    beyond a joint limit, a straight line the tool leaves."""
+    out = []
     ranges = scene.robot.view.arm_range
     ik = scene.ctx.arm_ik
     for seg, label in zip(prim.segments, labels, strict=True):
@@ -78,7 +91,9 @@ def _arm(scene: Scene, prim: ArmMotion) -> list[str]:
     return out
 
 
-def _pose(scene: Scene, prim: HandPose, name: str) -> list[str]:
+def hand_pose(scene: Scene, prim: HandPose) -> list[str]:
+    """Whether every joint a hand pose sets is inside its range."""
+    name = prim.pose
     out = []
     ranges = scene.robot.view.hand_range
     for k in range(16):

@@ -16,57 +16,41 @@ set-points going straight to the pose. The others are previewed at their start, 
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field
 
 import numpy as np
 
 from dial.backend.ik import IKError
 from dial.instructions.types import FINGERS
-from dial.parser.script import EventDef
+from dial.preview.moves import Check, Found
 from dial.preview.places import Places
 from dial.preview.scene import HAND, Scene, State, finger_group
-from dial.primitives.arm import Planner, PumaCommand
+from dial.primitives.arm import Planner, PumaProgram, PumaStatement
 from dial.primitives.context import Context
-from dial.scheduler.types import Outcome, RunInfo
+from dial.scene.valii import Statement
+from dial.scheduler.primitive import Allotment, Outcome
 
 STEP = 0.002  # m: the step of a guarded move's line
 BISECT = 5  # halvings of the last step once a guarded move touches (to 0.06 mm)
 LAG = 0.003  # m: a guarded move whose tool or fingertip lags its line more cannot follow it
 CLOSE_STEP = np.radians(0.5)  # rad: a grasp's closing step
 
-Check = Callable[[], None]  # pose the scene and record its problems
 
+class PreviewProgram(PumaProgram):
+    """``puma_command "ex PROG"`` planned statement by statement: an unreachable statement
+    is reported (naming the program, its line and the world file's line) and skipped, so
+    that the rest is still previewed; ``labels`` names the statement of each planned
+    segment, ``targets`` counts the statements."""
 
-@dataclass
-class Report:
-    """What a previewed instruction found: its outcome, and problems (messages)."""
-
-    outcome: Outcome
-    problems: list[str] = field(default_factory=list)
-
-
-class PreviewPuma(PumaCommand):
-    """``puma_command`` planned statement by statement: an unreachable statement is reported
-    (naming the program, its line and the world file's line) and skipped, so that the rest
-    is still previewed; ``labels`` names the statement of each planned segment."""
-
-    labels: list[str]
-    problems: list[str]
-    targets: int  # statements planned, reachable or not
-
-    def __init__(self, ctx: Context, info: RunInfo, places: Places) -> None:
-        super().__init__(ctx, info)
+    def __init__(self, ctx: Context, allotted: Allotment, program: str, places: Places) -> None:
+        super().__init__(ctx, allotted, program)
         self.places = places  # where statements are written (the walk's)
+        self.labels: list[str] = []
+        self.problems: list[str] = []
+        self.targets = 0
 
     def plan(self, planner: Planner) -> None:
-        self.labels, self.problems, self.targets = [], [], 1
-        if self.arg("verb") != "ex":
-            super().plan(planner)
-            words = (w.text for p in self.info.event.definition.params for w in p.words)
-            self.labels = [" ".join(words)] * len(planner.segments)
-            return
-        name = str(self.arg("program"))
-        world = self.ctx.world
+        name, world = self.program, self.ctx.world
+        self.labels, self.problems = [], []
         self.targets = len(world.programs[name].statements)
         for st in world.programs[name].statements:
             place = self.places.statement(world.path, name, st.line)
@@ -80,20 +64,48 @@ class PreviewPuma(PumaCommand):
 
     def label_at(self, progress: float) -> str:
         """The statement the arm follows at ``progress`` (as :meth:`step` picks segments)."""
-        for label, end in zip(self.labels, self.bounds, strict=True):
-            if progress <= end + 1e-12:
-                return label
-        return self.labels[-1] if self.labels else ""
+        return _label_at(self.labels, self.bounds, progress)
 
 
-def guarded(scene: Scene, event: EventDef, check: Check) -> Report:
+class PreviewStatement(PumaStatement):
+    """``puma_command "move LOC"`` and the other one-statement commands, labelled by the
+    command as written."""
+
+    problems: tuple[str, ...] = ()
+
+    def __init__(
+        self, ctx: Context, allotted: Allotment, statement: Statement, verb: str, written: str
+    ) -> None:
+        super().__init__(ctx, allotted, statement, verb)
+        self.written = written
+        self.labels: list[str] = []
+
+    def plan(self, planner: Planner) -> None:
+        super().plan(planner)
+        self.labels = [self.written] * len(planner.segments)
+
+    def label_at(self, progress: float) -> str:
+        return _label_at(self.labels, self.bounds, progress)
+
+
+def _label_at(labels: list[str], bounds: list[float], progress: float) -> str:
+    for label, end in zip(labels, bounds, strict=True):
+        if progress <= end + 1e-12:
+            return label
+    return labels[-1] if labels else ""
+
+
+def guarded(
+    scene: Scene,
+    check: Check,
+    finger: int | None,
+    displacement: tuple[float, float, float],
+    travel: float | None,
+    frame: str,
+) -> Found:
     """A guarded move, stopped at the first touch (see the module's docstring)."""
-    args = event.args
-    finger = args["finger"] if isinstance(args["finger"], int) else None
-    d = np.array([args[k] for k in ("dx", "dy", "dz")], dtype=np.float64)
-    travel = args["max"]
-    length = float(travel) if isinstance(travel, float) else float(np.linalg.norm(d))
-    frame = args.get("frame") or ("tool" if finger is None else "palm")
+    d = np.array(displacement, dtype=np.float64)
+    length = travel if travel is not None else float(np.linalg.norm(d))
     pos, rot = scene.tool()
     direction = d / np.linalg.norm(d)
     delta = direction if frame == "world" else rot @ direction
@@ -121,10 +133,10 @@ def guarded(scene: Scene, event: EventDef, check: Check) -> Report:
         check()
         if scene.touching(groups, held=False):
             _bisect(scene, before, reach, s, s_next, groups)
-            return Report(Outcome.DONE)
+            return Found(Outcome.DONE)
         if lag > LAG:
             who = "the tool" if finger is None else f"the {FINGERS[finger]} fingertip"
-            return Report(
+            return Found(
                 Outcome.MISSED,
                 [
                     f"{who} cannot follow the guarded move's line beyond {s * 1000:.0f} mm of "
@@ -133,7 +145,7 @@ def guarded(scene: Scene, event: EventDef, check: Check) -> Report:
                 ],
             )
         s = s_next
-    return Report(Outcome.MISSED)
+    return Found(Outcome.MISSED)
 
 
 def _bisect(
@@ -157,11 +169,8 @@ def _bisect(
     scene.restore(touching)
 
 
-def grasp(scene: Scene, event: EventDef, check: Check) -> Report:
+def grasp(scene: Scene, check: Check, jmask: int, tmask: int) -> Found:
     """Close the masked joints until each finger touches something or meets its limits."""
-    masks = event.args["masks"]
-    assert isinstance(masks, tuple)
-    jmask, tmask = masks
     joints = [k for k in range(16) if jmask >> k & 1]
     fingers = sorted({k // 4 for k in joints})
     watched = {k // 4 for k in range(16) if tmask >> k & 1} or set(fingers)
@@ -182,12 +191,11 @@ def grasp(scene: Scene, event: EventDef, check: Check) -> Report:
     bodies = {b for b in lifted if b is not None}
     if bodies:
         scene.hold(bodies, list(stopped))
-    return Report(Outcome.DONE if watched <= set(stopped) else Outcome.MISSED)
+    return Found(Outcome.DONE if watched <= set(stopped) else Outcome.MISSED)
 
 
-def sense(scene: Scene, event: EventDef) -> Outcome:
-    """A sensing instruction's outcome, predicted from the pose (see the module's docstring)."""
-    finger = event.args.get("finger")
-    if isinstance(finger, int):
-        return Outcome.DONE if scene.touching({finger_group(finger)}) else Outcome.MISSED
-    return Outcome.DONE
+def sensed(scene: Scene, finger: int | None) -> Outcome:
+    """A sensing run's outcome, predicted from the pose (see the module's docstring)."""
+    if finger is None:
+        return Outcome.DONE
+    return Outcome.DONE if scene.touching({finger_group(finger)}) else Outcome.MISSED

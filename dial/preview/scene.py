@@ -20,7 +20,7 @@ from dial.backend.ik import ArmIK
 from dial.backend.model import ARM_HOME, load_model, load_untextured, scene_bodies
 from dial.instructions.types import FINGERS
 from dial.preview.ik import FingerIKOnDemand, LeanArmIK
-from dial.primitives import Context
+from dial.primitives.context import Context
 from dial.robot.snapshot import FloatArray
 from dial.scene.world import World
 from dial.teach.contacts import FIXED_DEPTH, OBJECT_DEPTH, Parts

@@ -14,27 +14,27 @@ which the walk then goes on); a loop's body once; a call's timeline in place.
 from __future__ import annotations
 
 from collections import defaultdict
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 
 from dial.backend.driver import CONTROL_PERIOD
 from dial.errors import DialError
 from dial.parser.ast import Condition
-from dial.parser.script import EventDef, Run, Script, Step, TBlock, TCall, TIf, TOn, TRepeat, Watch
-from dial.preview import checks
-from dial.preview.motions import PreviewPuma, Report, grasp, guarded, sense
+from dial.parser.script import Run, Script, Step, TBlock, TCall, TIf, TOn, TRepeat, Watch
+from dial.preview.motions import sensed
+from dial.preview.moves import AtOnce, Making, P, Sensed, Stepped
 from dial.preview.places import Place, Places
 from dial.preview.report import Counts, Problems
 from dial.preview.scene import Hit, Scene, State, finger_group
-from dial.primitives import CLASSES
-from dial.primitives.arm import ArmMotion
 from dial.robot.protocol import Course
 from dial.robot.snapshot import FloatArray, Snapshot
-from dial.scheduler.types import Now, Outcome, Primitive, RunInfo
+from dial.scheduler.primitive import Now, Outcome, Primitive
+from dial.scheduler.types import RunInfo
 
 ARM_STEP = np.radians(0.25)  # rad of any arm joint between two checks of a moving pose
 HAND_STEP = np.radians(1.0)  # rad of any hand joint
@@ -43,7 +43,8 @@ Latest = dict[tuple[str, str], Outcome]
 
 @dataclass
 class Active:
-    """A fixed-length run being stepped: where it is written, and its progress."""
+    """A fixed-length run being stepped: where it is written, and its progress;
+    ``finished``: the problems with where it got; ``label``: what it does at a progress."""
 
     place: Place
     run: Run
@@ -51,7 +52,16 @@ class Active:
     effectors: frozenset[str]
     span: int  # its executing ticks, in control periods
     start_clock: int
+    finished: Callable[[], list[str]]
+    label: Callable[[float], str]
     progress: float = 0.0
+
+
+class Starting(NamedTuple):
+    """The run being started: where it is written, and its place in the timeline."""
+
+    place: Place
+    info: RunInfo
 
 
 @dataclass(frozen=True)
@@ -96,6 +106,7 @@ class Walk:
         self.ongoing: dict[tuple[str, str, str], tuple[Place, str]] = {}
         self.seen = (scene.robot.arm_target.copy(), scene.robot.hand_target.copy())
         self.places = Places()  # statement places, the world files read once per preview
+        self.starting: Starting | None = None  # the run a move is starting
 
     # -- the timeline ------------------------------------------------------------------------------
     def steps(self, script: Script, steps: tuple[Step, ...], label: str) -> None:
@@ -143,8 +154,10 @@ class Walk:
             self.why = before
 
     def test(self, script: Script, cond: Condition) -> bool:
-        if cond.event in script.condition_only:
-            self.latest[(script.path, cond.event)] = sense(self.scene, script.events[cond.event])
+        if cond.event in script.condition_only:  # a sensing event: sensed now
+            outcome = script.events[cond.event].args.preview().begin(self)
+            if outcome is not None:
+                self.latest[(script.path, cond.event)] = outcome
         return (self.latest.get((script.path, cond.event)) is Outcome.DONE) != cond.negated
 
     def save(self) -> Saved:
@@ -234,9 +247,8 @@ class Walk:
             for watch in armed:
                 if watch.event != on.condition.event:
                     continue
-                finger = script.events[watch.event].args["finger"]
-                assert isinstance(finger, int)
-                if self.scene.touching({finger_group(finger)}) != on.condition.negated:
+                touching = self.scene.touching({finger_group(watch.contact.finger)})
+                if touching != on.condition.negated:
                     outcome = Outcome.MISSED if on.condition.negated else Outcome.DONE
                     self.latest[(script.path, on.condition.event)] = outcome
                     return on
@@ -259,68 +271,72 @@ class Walk:
                 keep = self.save()
         self.restore(keep)
 
-    # -- runs --------------------------------------------------------------------------------------
+    # -- runs: each instruction's record says how it moves (dial.preview.moves) -------------
     def start(self, script: Script, run: Run) -> None:
         event = script.events[run.event]
         place = Place(script.path, run.line, run.span.col or 1, run.event)
         for effector in event.effectors:
             self.owner[effector] = place
-        name, key = event.instruction.name, (script.path, run.event)
         self.scene.pose()
-        if name in ("guarded_move", "grasp_force"):
-            arm = name == "guarded_move" and not isinstance(event.args["finger"], int)
-            self.counts.arm += arm
-            self.counts.hand += not arm
-            self.latest[key] = self.at_once(place, event)
-            return
-        if event.instruction.length != "fixed":  # sensing, contact waits
-            self.latest[key] = sense(self.scene, event)
-            return
-        prim = self.primitive(RunInfo(event, run, script.path, self.n, CONTROL_PERIOD))
+        self.starting = Starting(place, RunInfo(event, run, script.path, self.n, CONTROL_PERIOD))
+        outcome = event.args.preview().begin(self)
+        if outcome is not None:
+            self.latest[(script.path, run.event)] = outcome
+
+    def stepped(self, move: Stepped[P]) -> Outcome | None:
+        """Start a fixed-length run's primitive; :meth:`periods` steps it from now on."""
+        assert self.starting is not None, "a move begins in Walk.start"
+        place, info = self.starting
+        written = " ".join(w.text for p in info.event.definition.params for w in p.words)
+        scene = self.scene
+        prim = move.make(Making(scene.ctx, info.allotment, self.places, written))
         try:
-            prim.start(self.scene.robot.snapshot())
+            prim.start(scene.robot.snapshot())
         except DialError as e:
             self.problems.add(place, str(e), self.why)
-            self.latest[key] = Outcome.ERROR
-            return
-        for message in checks.started(self.scene, prim, event):
+            return Outcome.ERROR
+        for message in move.started(scene, prim):
             self.problems.add(place, message, self.why)
-        if isinstance(prim, ArmMotion):
-            self.counts.arm += prim.targets if isinstance(prim, PreviewPuma) else 1
-        elif name != "limp":
-            self.counts.hand += 1
-        span = (run.exec_end - run.start + 1) * self.n
-        self.active.append(Active(place, run, prim, event.effectors, span, self.clock))
+        arm, hand = move.counts(prim)
+        self.counts.arm += arm
+        self.counts.hand += hand
 
-    def primitive(self, info: RunInfo) -> Primitive[Snapshot]:
-        """The run's own primitive; ``puma_command``'s planned a statement at a time."""
-        name = info.event.instruction.primitive
-        ctx = self.scene.ctx
-        if name == "PumaCommand":
-            return PreviewPuma(ctx, info, self.places)
-        made = CLASSES[name](ctx, info)
-        assert isinstance(made, Primitive), "a fixed-length instruction has a primitive"
-        return made
+        def finished() -> list[str]:
+            return move.finished(scene, prim)
 
-    def at_once(self, place: Place, event: EventDef) -> Outcome:
+        def label(progress: float) -> str:
+            return move.label(prim, progress)
+
+        effectors, span = info.event.effectors, info.span
+        self.active.append(
+            Active(place, info.run, prim, effectors, span, self.clock, finished, label)
+        )
+        return None
+
+    def at_once(self, move: AtOnce) -> Outcome:
         """A guarded move or a grasp, previewed whole now."""
-        self.current = place
+        assert self.starting is not None, "a move begins in Walk.start"
+        place = self.current = self.starting.place
+        self.counts.arm += move.arm
+        self.counts.hand += not move.arm
         try:
-            motion = guarded if event.instruction.name == "guarded_move" else grasp
-            report: Report = motion(self.scene, event, self.record)
+            found = move.motion(self.scene, self.record)
         finally:
             self.current = None
-        for message in report.problems:
+        for message in found.problems:
             self.problems.add(place, message, self.why)
         self.look()
-        return report.outcome
+        return found.outcome
+
+    def sensed(self, move: Sensed) -> Outcome:
+        return sensed(self.scene, move.finger)
 
     def finish(self, script: Script, k: int) -> None:
         """End the runs whose last executing tick ``k`` was."""
         for a in [a for a in self.active if a.run.exec_end == k]:
             self.scene.pose()
             ended = a.prim.finish(self.scene.robot.snapshot())
-            for message in (*ended.warnings, *checks.finished(self.scene, a.prim)):
+            for message in (*ended.warnings, *a.finished()):
                 self.problems.add(a.place, message, self.why)
             self.latest[(script.path, a.run.event)] = ended.outcome
             a.prim.stop()
@@ -367,8 +383,7 @@ class Walk:
             moving = [a for a in self.active if who in a.effectors]
             if moving:
                 a = moving[-1]
-                label = a.prim.label_at(a.progress) if isinstance(a.prim, PreviewPuma) else ""
-                return a.place, label
+                return a.place, a.label(a.progress)
         for who in movers:
             if who in self.owner:
                 return self.owner[who], ""

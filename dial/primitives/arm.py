@@ -26,7 +26,7 @@ from dial.robot.protocol import Course
 from dial.robot.slots import still
 from dial.robot.snapshot import FloatArray, Snapshot
 from dial.scene.valii import Appro, Depart, Drive, Move, Statement
-from dial.scheduler.types import DONE, Ended, Now, Outcome, RunInfo
+from dial.scheduler.primitive import DONE, Allotment, Ended, Now, Outcome
 
 JOINT_SPEED = 1.0  # rad/s: nominal, only to share a run's time among its segments
 LINEAR_SPEED = 0.25  # m/s
@@ -126,21 +126,22 @@ class Planner:
 
     def statement(self, st: Statement, where: str) -> None:
         ik = self.ctx.arm_ik
-        if isinstance(st, Move):
-            pos, rot = self.ctx.location(st.location)
-            if st.straight:
-                self.line_to(pos, rot, f"location '{st.location}' ({where})")
-            else:
-                self.joint_to(ik.solve(pos, rot, self.q, f"location '{st.location}' ({where})"))
-        elif isinstance(st, Appro):
-            pos, rot = self.ctx.location(st.location)
-            pos = pos - st.distance * rot[:, 2]
-            self.joint_to(ik.solve(pos, rot, self.q, f"APPRO {st.location} ({where})"))
-        elif isinstance(st, Depart):
-            p0, r0 = ik.fk(self.q)
-            self.line_to(p0 - st.distance * r0[:, 2], r0, f"DEPART ({where})")
-        else:
-            self.joint_to(self.drive(st, where))
+        match st:
+            case Move(location=location, straight=True):
+                pos, rot = self.ctx.location(location)
+                self.line_to(pos, rot, f"location '{location}' ({where})")
+            case Move(location=location):
+                pos, rot = self.ctx.location(location)
+                self.joint_to(ik.solve(pos, rot, self.q, f"location '{location}' ({where})"))
+            case Appro(location=location, distance=distance):
+                pos, rot = self.ctx.location(location)
+                pos = pos - distance * rot[:, 2]
+                self.joint_to(ik.solve(pos, rot, self.q, f"APPRO {location} ({where})"))
+            case Depart(distance=distance):
+                p0, r0 = ik.fk(self.q)
+                self.line_to(p0 - distance * r0[:, 2], r0, f"DEPART ({where})")
+            case Drive():
+                self.joint_to(self.drive(st, where))
 
     def drive(self, st: Drive, where: str) -> FloatArray:
         """DRIVE: one joint by an angle, stopped at the joint's limit with a warning."""
@@ -162,8 +163,8 @@ class Planner:
 class ArmMotion(RobotPrimitive):
     """Follows planned segments over the run's progress (tick time)."""
 
-    def __init__(self, ctx: Context, info: RunInfo) -> None:
-        super().__init__(ctx, info)
+    def __init__(self, ctx: Context, allotted: Allotment) -> None:
+        super().__init__(ctx, allotted)
         self.segments: list[Segment] = []
         self.bounds: list[float] = []
         self.warnings: tuple[str, ...] = ()
@@ -210,7 +211,7 @@ class ArmMotion(RobotPrimitive):
         if not self.segments:
             return still
         if self._table is None:
-            n, span = self.info.periods_per_tick, self.info.span
+            n, span = self.allotted.periods_per_tick, self.allotted.span
             self._progress = (
                 [1.0] * span if span == n else [min(1.0, k / span) for k in range(1, span + 1)]
             )
@@ -239,37 +240,51 @@ class ArmMotion(RobotPrimitive):
         return Ended(Outcome.DONE, warnings=self.warnings) if self.warnings else DONE
 
 
-class PumaCommand(ArmMotion):
-    """``puma_command "ex PROG" | "move LOC" | ...``: the VAL-II subset."""
+class PumaProgram(ArmMotion):
+    """``puma_command "ex PROG"``: the world file's stored program ``program``."""
+
+    def __init__(self, ctx: Context, allotted: Allotment, program: str) -> None:
+        super().__init__(ctx, allotted)
+        self.program = program
 
     def plan(self, planner: Planner) -> None:
-        verb = self.arg("verb")
-        if verb == "ex":
-            name = str(self.arg("program"))
-            for stored in self.ctx.world.programs[name].statements:
-                planner.statement(stored, f"program {name}, line {stored.line}")
-            return
-        line = 1
-        st: Statement
-        if verb in ("move", "moves"):
-            st = Move(line, str(self.arg("location")), verb == "moves")
-        elif verb == "appro":
-            st = Appro(line, str(self.arg("location")), self.num("distance"))
-        elif verb == "depart":
-            st = Depart(line, self.num("distance"))
-        else:
-            st = Drive(line, int(self.num("joint")), self.num("angle"))
-        planner.statement(st, str(verb))
+        name = self.program
+        for stored in self.ctx.world.programs[name].statements:
+            planner.statement(stored, f"program {name}, line {stored.line}")
+
+
+class PumaStatement(ArmMotion):
+    """``puma_command "move LOC"`` (or moves, appro, depart, drive): one VAL-II statement;
+    ``verb`` names it in messages."""
+
+    def __init__(self, ctx: Context, allotted: Allotment, statement: Statement, verb: str) -> None:
+        super().__init__(ctx, allotted)
+        self.statement, self.verb = statement, verb
+
+    def plan(self, planner: Planner) -> None:
+        planner.statement(self.statement, self.verb)
 
 
 class ArmMove(ArmMotion):
-    """``arm_move DX DY DZ [RX RY RZ] [frame=tool|world]``: a relative straight line."""
+    """``arm_move DX DY DZ [RX RY RZ] [frame=tool|world]``: a relative straight line of
+    ``displacement`` (m) and ``rotation`` (roll, pitch, yaw in rad) in ``frame``."""
+
+    def __init__(
+        self,
+        ctx: Context,
+        allotted: Allotment,
+        displacement: tuple[float, float, float],
+        rotation: tuple[float, float, float],
+        frame: str,
+    ) -> None:
+        super().__init__(ctx, allotted)
+        self.displacement, self.rotation, self.frame = displacement, rotation, frame
 
     def plan(self, planner: Planner) -> None:
         p0, r0 = self.ctx.arm_ik.fk(planner.q)
-        d = np.array([self.num("dx"), self.num("dy"), self.num("dz")], dtype=np.float64)
-        turn = rpy_matrix((self.num("rx"), self.num("ry"), self.num("rz")))
-        if self.arg("frame") == "tool":
+        d = np.array(self.displacement, dtype=np.float64)
+        turn = rpy_matrix(self.rotation)
+        if self.frame == "tool":
             p1, r1 = p0 + r0 @ d, r0 @ turn
         else:
             p1, r1 = p0 + d, turn @ r0

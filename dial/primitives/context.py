@@ -15,7 +15,7 @@ from dial.robot.slots import Slots
 from dial.robot.snapshot import Snapshot, Touch
 from dial.robot.view import RobotView
 from dial.scene.world import World
-from dial.scheduler.types import Ended, Outcome, Primitive, RunInfo
+from dial.scheduler.primitive import Allotment, Ended, Outcome, Primitive
 
 
 @dataclass
@@ -44,21 +44,11 @@ class Context:
 
 
 class RobotPrimitive(Primitive[Snapshot]):
-    """A primitive on the MuJoCo robot: its run, arguments and command slots."""
+    """A primitive on a robot: the run's context, allotment and command slots."""
 
-    def __init__(self, ctx: Context, info: RunInfo) -> None:
-        self.ctx, self.info = ctx, info
-        self.args = info.event.args
-        self.slots = Slots(ctx.robot, info.event.effectors)
-
-    def arg(self, name: str) -> object:
-        return self.args[name]
-
-    def num(self, name: str) -> float:
-        """A bound numeric argument (SI units)."""
-        value = self.args[name]
-        assert isinstance(value, int | float), f"{name} is bound as a number"
-        return float(value)
+    def __init__(self, ctx: Context, allotted: Allotment) -> None:
+        self.ctx, self.allotted = ctx, allotted
+        self.slots = Slots(ctx.robot, allotted.effectors)
 
 
 def done(**data: object) -> Ended:

@@ -13,38 +13,46 @@ for ``record_contact at=stop``: a light contact may fade within tens of ms.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 
-from dial.instructions.types import FINGERS
+from dial.instructions.types import FINGERS, ContactKind
 from dial.primitives.context import Context, RobotPrimitive, done, missed
 from dial.robot.snapshot import FloatArray, Snapshot
-from dial.scheduler.types import Ended, Now, RunInfo
+from dial.scheduler.primitive import Allotment, Ended, Now
 
 
 class GuardedMove(RobotPrimitive):
-    def __init__(self, ctx: Context, info: RunInfo) -> None:
-        super().__init__(ctx, info)
-        finger = self.arg("finger")
-        self.finger: int | None = finger if isinstance(finger, int) else None
-        d = np.array([self.num("dx"), self.num("dy"), self.num("dz")], dtype=np.float64)
-        travel = self.arg("max")
-        self.length = float(travel) if isinstance(travel, float) else float(np.linalg.norm(d))
+    """Moves ``finger`` (None: the arm's tool) along ``displacement`` (m, in ``frame``) at
+    ``speed`` (m/s), for ``travel`` (m; None: the displacement's length), until one of the
+    ``until`` conditions holds on a ``sense`` finger; then ``press`` (m) further on."""
+
+    def __init__(
+        self,
+        ctx: Context,
+        allotted: Allotment,
+        *,
+        finger: int | None,
+        displacement: tuple[float, float, float],
+        travel: float | None,
+        frame: str,
+        speed: float,
+        press: float,
+        until: Sequence[tuple[ContactKind, float]],
+        sense: tuple[int, ...],
+    ) -> None:
+        super().__init__(ctx, allotted)
+        self.finger = finger
+        d = np.array(displacement, dtype=np.float64)
+        self.length = travel if travel is not None else float(np.linalg.norm(d))
         self.direction = d / np.linalg.norm(d)
-        self.speed = self.num("speed")
-        self.press = self.num("press")
-        sense = self.arg("sense")
-        if isinstance(sense, int):
-            self.sense: tuple[int, ...] = (sense,)
-        else:
-            self.sense = (self.finger,) if self.finger is not None else tuple(range(4))
-        until = self.arg("until")
-        assert isinstance(until, tuple)
-        self.until: tuple[tuple[str, float], ...] = until
+        self.frame, self.speed, self.press = frame, speed, press
+        self.until, self.sense = tuple(until), sense
         self.guard = 0
 
     def start(self, snapshot: Snapshot) -> None:
-        frame = self.arg("frame") or ("tool" if self.finger is None else "palm")
-        world = frame == "world"
+        world = self.frame == "world"
         self.delta = self.direction if world else snapshot.tool_rot @ self.direction
         self.arm_q = snapshot.arm_target.copy()
         self.hand = snapshot.hand_target.copy()
@@ -60,7 +68,7 @@ class GuardedMove(RobotPrimitive):
 
     def step(self, snapshot: Snapshot, now: Now) -> Ended | None:
         trip = snapshot.trips.get(self.guard)
-        travel = min(self.speed * (now.elapsed - self.info.period), self.length)
+        travel = min(self.speed * (now.elapsed - self.allotted.period), self.length)
         if trip is not None:
             self.ctx.stops[trip.finger] = trip.touch
             if self.press > 0.0:  # the driver froze the effector at contact: lean in a little
@@ -80,7 +88,7 @@ class GuardedMove(RobotPrimitive):
             )
         if travel >= self.length:
             return missed(f"no contact within {self.length * 1000:.0f} mm", travel=travel)
-        goal = self.p0 + self.delta * (travel + self.speed * self.info.period)
+        goal = self.p0 + self.delta * (travel + self.speed * self.allotted.period)
         self._command(goal, self.arm_q, self.hand, 2)
         return None
 

@@ -11,7 +11,7 @@ from dial.primitives.context import Context, RobotPrimitive, done, missed
 from dial.robot.protocol import Course
 from dial.robot.slots import still
 from dial.robot.snapshot import FloatArray, Snapshot
-from dial.scheduler.types import Ended, Now, RunInfo
+from dial.scheduler.primitive import Allotment, Ended, Now
 
 
 def _bits(mask: int) -> list[int]:
@@ -19,12 +19,16 @@ def _bits(mask: int) -> list[int]:
 
 
 class HandPose(RobotPrimitive):
-    """``hand_pose "NAME" [fingers=MASK]``: GOTO for ``#``, interpolated for ``#===``."""
+    """``hand_pose "NAME" [fingers=MASK]``: the joints of the world's pose ``pose`` (only
+    those in ``fingers``, a mask); GOTO for ``#``, interpolated for ``#===``."""
+
+    def __init__(self, ctx: Context, allotted: Allotment, pose: str, fingers: int) -> None:
+        super().__init__(ctx, allotted)
+        self.pose, self.fingers = pose, fingers
 
     def start(self, snapshot: Snapshot) -> None:
-        pose = self.ctx.world.poses[str(self.arg("pose"))]
-        fingers = self.arg("fingers")
-        self.mask = pose.mask & (fingers if isinstance(fingers, int) else 0xFFFF)
+        pose = self.ctx.world.poses[self.pose]
+        self.mask = pose.mask & self.fingers
         self.q0 = snapshot.hand_target.copy()
         self.q1 = self.q0.copy()
         for bit, angle in pose.angles.items():
@@ -51,12 +55,14 @@ class GraspForce(RobotPrimitive):
     and missed if they all reach their joint limits first.
     """
 
+    def __init__(
+        self, ctx: Context, allotted: Allotment, jmask: int, tmask: int, force: float, speed: float
+    ) -> None:
+        super().__init__(ctx, allotted)
+        self.jmask, self.tmask, self.force, self.speed = jmask, tmask, force, speed
+
     def start(self, snapshot: Snapshot) -> None:
-        masks = self.arg("masks")
-        assert isinstance(masks, tuple)
-        self.jmask, self.tmask = masks
-        self.force = self.num("force")
-        self.rate = self.num("speed") * self.info.period
+        self.rate = self.speed * self.allotted.period
         self.target = snapshot.hand_target.copy()
         self.fingers = sorted({k // 4 for k in _bits(self.jmask)})
         self.watched = {
@@ -97,9 +103,9 @@ class GraspForce(RobotPrimitive):
 class Limp(RobotPrimitive):
     """``limp [fingers=MASK] [save=NAME]``: back-drivable joints; the reached pose is recorded."""
 
-    def __init__(self, ctx: Context, info: RunInfo) -> None:
-        super().__init__(ctx, info)
-        self.mask = int(self.num("fingers"))
+    def __init__(self, ctx: Context, allotted: Allotment, mask: int, save: str | None) -> None:
+        super().__init__(ctx, allotted)
+        self.mask, self.save = mask, save
         self.limp = False
 
     def start(self, snapshot: Snapshot) -> None:
@@ -118,7 +124,7 @@ class Limp(RobotPrimitive):
         self.slots.limp(self.mask, False)
         self.limp = False
         pose = {f"j{k}": float(np.degrees(snapshot.hand_q[k])) for k in _bits(self.mask)}
-        save = self.arg("save")
+        save = self.save
         return done(pose_deg=pose, **({"saved_as": save} if save else {}))
 
     def stop(self) -> None:  # ended early (preempted, aborted): stiffen where the joints are
@@ -129,14 +135,24 @@ class Limp(RobotPrimitive):
 class FingerMove(RobotPrimitive):
     """``finger_move finger=F DX DY DZ [frame=palm|world]``: a straight fingertip line by IK."""
 
+    def __init__(
+        self,
+        ctx: Context,
+        allotted: Allotment,
+        finger: int,
+        displacement: tuple[float, float, float],
+        frame: str,
+    ) -> None:
+        super().__init__(ctx, allotted)
+        self.finger, self.displacement, self.frame = finger, displacement, frame
+
     def start(self, snapshot: Snapshot) -> None:
-        self.finger = int(self.num("finger"))
         self.arm_q = snapshot.arm_target.copy()
         self.hand = snapshot.hand_target.copy()
         ik = self.ctx.finger_ik
         self.tip0 = ik.tip(self.arm_q, self.hand, self.finger)
-        d = np.array([self.num("dx"), self.num("dy"), self.num("dz")], dtype=np.float64)
-        self.delta: FloatArray = snapshot.tool_rot @ d if self.arg("frame") == "palm" else d
+        d = np.array(self.displacement, dtype=np.float64)
+        self.delta: FloatArray = snapshot.tool_rot @ d if self.frame == "palm" else d
         self.mask = 0xF << (4 * self.finger)
 
     def step(self, snapshot: Snapshot, now: Now) -> Ended | None:

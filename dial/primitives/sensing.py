@@ -2,35 +2,36 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import TYPE_CHECKING
+
 import numpy as np
 
-from dial.instructions.catalogue import contact_condition
-from dial.instructions.types import FINGERS
+from dial.instructions.types import FINGERS, Contact
 from dial.primitives.context import Context, RobotPrimitive, done, missed
 from dial.robot.contact import contact_reading
 from dial.robot.snapshot import FloatArray, Snapshot
-from dial.scheduler.types import Ended, Now, Outcome, RunInfo
+from dial.scheduler.primitive import Allotment, Ended, Now, Outcome
+
+if TYPE_CHECKING:
+    from dial.haptics import PlaneFit, SuperquadricFit
 
 
 class Get:
-    """``get_joints``, ``get_forces``, ``get_tactile``, ``get_wrist``: record a snapshot."""
+    """``get_joints``, ``get_forces``, ``get_tactile``, ``get_wrist``: record what ``read``
+    takes from the snapshot."""
 
-    def __init__(self, ctx: Context, info: RunInfo) -> None:
-        self.what = info.event.instruction.name
+    def __init__(self, read: Callable[[Snapshot], dict[str, object]]) -> None:
+        self.read = read
 
     def sense(self, snapshot: Snapshot) -> Ended:
-        if self.what == "get_joints":
-            return done(hand_q=snapshot.hand_q, arm_q=snapshot.arm_q)
-        if self.what == "get_forces":
-            return done(tensions=snapshot.tensions)
-        if self.what == "get_tactile":
-            return done(tactile=snapshot.tactile)
-        return done(pos=snapshot.tool_pos, rot=snapshot.tool_rot)
+        return done(**self.read(snapshot))
 
 
-def contact_value(kind: str, snapshot: Snapshot, finger: int, baseline: FloatArray | None) -> float:
+def contact_value(contact: Contact, snapshot: Snapshot, baseline: FloatArray | None) -> float:
     """The reading a contact condition compares with its threshold (m or N); a dropped-out
     sensor reads 0, as the driver's guards read it."""
+    kind, finger = contact.kind, contact.finger
     if (kind, finger) in snapshot.dropped:
         return 0.0
     return contact_reading(
@@ -45,30 +46,33 @@ def contact_value(kind: str, snapshot: Snapshot, finger: int, baseline: FloatArr
 
 
 class ContactWait(RobotPrimitive):
-    """``position_contact``, ``force_contact``, ``tactile_contact``.
+    """``position_contact``, ``force_contact``, ``tactile_contact`` in a diagram: wait until
+    the contact is signalled (a force change counts from the run's start)."""
 
-    In a diagram: wait until the contact is signalled (a force change counts from the
-    run's start). As a condition-only event: is the contact there now (:meth:`sense`)?
-    """
-
-    def __init__(self, ctx: Context, info: RunInfo) -> None:
-        super().__init__(ctx, info)
-        self.kind, self.finger, self.threshold = contact_condition(
-            info.event.instruction, info.event.args
-        )
+    def __init__(self, ctx: Context, allotted: Allotment, contact: Contact) -> None:
+        super().__init__(ctx, allotted)
+        self.contact = contact
 
     def start(self, snapshot: Snapshot) -> None:
         self.baseline = snapshot.differentials.copy()
 
     def step(self, snapshot: Snapshot, now: Now) -> Ended | None:
-        value = contact_value(self.kind, snapshot, self.finger, self.baseline)
-        return done(value=value) if value >= self.threshold else None
+        value = contact_value(self.contact, snapshot, self.baseline)
+        return done(value=value) if value >= self.contact.threshold else None
+
+
+class ContactTest:
+    """A contact instruction as a condition-only event: is the contact there now?"""
+
+    def __init__(self, contact: Contact) -> None:
+        self.contact = contact
 
     def sense(self, snapshot: Snapshot) -> Ended:
-        value = contact_value(self.kind, snapshot, self.finger, None)
-        if value >= self.threshold:
+        kind, finger, threshold = self.contact
+        value = contact_value(self.contact, snapshot, None)
+        if value >= threshold:
             return done(value=value)
-        return missed(f"no {self.kind} contact on the {FINGERS[self.finger]}", value=value)
+        return missed(f"no {kind} contact on the {FINGERS[finger]}", value=value)
 
 
 class RecordContact:
@@ -79,14 +83,8 @@ class RecordContact:
     or as it was when the latest guarded move sensing this finger stopped (``at=stop``).
     """
 
-    def __init__(self, ctx: Context, info: RunInfo) -> None:
-        self.ctx = ctx
-        finger = info.event.args["finger"]
-        assert isinstance(finger, int)
-        self.finger = finger
-        self.set = str(info.event.args["into"])
-        self.at = str(info.event.args["at"])
-        self.source = str(info.event.args["source"])
+    def __init__(self, ctx: Context, finger: int, into: str, at: str, source: str) -> None:
+        self.ctx, self.finger, self.set, self.at, self.source = ctx, finger, into, at, source
 
     def sense(self, snapshot: Snapshot) -> Ended:
         name = FINGERS[self.finger]
@@ -117,12 +115,8 @@ class Locate:
     the believed orientations are kept.
     """
 
-    def __init__(self, ctx: Context, info: RunInfo) -> None:
-        self.ctx = ctx
-        self.location = str(info.event.args["location"])
-        also = info.event.args["also"]
-        assert isinstance(also, tuple)
-        self.also = tuple(str(a) for a in also)
+    def __init__(self, ctx: Context, location: str, also: tuple[str, ...]) -> None:
+        self.ctx, self.location, self.also = ctx, location, also
 
     def sense(self, snapshot: Snapshot) -> Ended:
         world = self.ctx.world
@@ -140,19 +134,20 @@ class Locate:
 
 
 class Fit:
-    """``fit_plane SET`` and ``fit_superquadric SET``: least squares over a point set."""
+    """``fit_plane SET`` and ``fit_superquadric SET``: ``fit`` (least squares) over a point
+    set."""
 
-    def __init__(self, ctx: Context, info: RunInfo) -> None:
-        self.ctx = ctx
-        self.set = str(info.event.args["set"])
-        self.kind = info.event.instruction.name
+    def __init__(
+        self, ctx: Context, point_set: str, fit: Callable[[FloatArray], PlaneFit | SuperquadricFit]
+    ) -> None:
+        self.ctx, self.set, self.fit = ctx, point_set, fit
 
     def sense(self, snapshot: Snapshot) -> Ended:
-        from dial.haptics import FitError, fit_plane, fit_superquadric  # SciPy: when fitting
+        from dial.haptics import FitError  # SciPy: only a run that fits loads it
 
         points = np.array(self.ctx.point_sets.get(self.set, []), dtype=np.float64).reshape(-1, 3)
         try:
-            fit = fit_plane(points) if self.kind == "fit_plane" else fit_superquadric(points)
+            fit = self.fit(points)
         except FitError as e:
             return Ended(Outcome.MISSED, f"point set '{self.set}': {e}")
         result = fit.as_result()

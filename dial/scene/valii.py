@@ -60,6 +60,15 @@ class Drive:
 
 Statement = Move | Appro | Depart | Drive
 
+
+@dataclass(frozen=True)
+class Ex:
+    """``EX PROG``: run the world file's stored program ``program`` (a command, not a
+    statement of a stored program)."""
+
+    program: str
+
+
 _USAGE = {
     "MOVE": "MOVE LOCATION",
     "MOVES": "MOVES LOCATION",

@@ -10,29 +10,26 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from dial.scheduler.log import EventLog, LogError
+    from dial.scheduler.primitive import DONE, Allotment, Ended, Now, Outcome, Primitive, Sensor
     from dial.scheduler.runner import Runner, RunSummary
     from dial.scheduler.signals import EXIT_STATUS, StopRequest, catch_stop_signals
     from dial.scheduler.types import (
-        DONE,
-        Ended,
         Interrupted,
-        Now,
-        Outcome,
-        Primitive,
         PrimitiveFactory,
         RunAborted,
         RunInfo,
-        Sensor,
         periods_per_tick,
     )
 
 _HOMES = {
     "dial.scheduler.log": ("EventLog", "LogError"),
+    "dial.scheduler.primitive": (
+        *("DONE", "Allotment", "Ended", "Now", "Outcome", "Primitive", "Sensor"),
+    ),
     "dial.scheduler.runner": ("Runner", "RunSummary"),
     "dial.scheduler.signals": ("EXIT_STATUS", "StopRequest", "catch_stop_signals"),
     "dial.scheduler.types": (
-        *("DONE", "Ended", "Interrupted", "Now", "Outcome", "Primitive", "PrimitiveFactory"),
-        *("RunAborted", "RunInfo", "Sensor", "periods_per_tick"),
+        *("Interrupted", "PrimitiveFactory", "RunAborted", "RunInfo", "periods_per_tick"),
     ),
 }
 _HOME = {name: module for module, names in _HOMES.items() for name in names}
@@ -40,6 +37,7 @@ _HOME = {name: module for module, names in _HOMES.items() for name in names}
 __all__ = [
     "DONE",
     "EXIT_STATUS",
+    "Allotment",
     "Ended",
     "EventLog",
     "Interrupted",

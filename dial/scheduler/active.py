@@ -5,7 +5,8 @@ from __future__ import annotations
 from typing import Generic, NamedTuple
 
 from dial.parser.script import Script
-from dial.scheduler.types import Ended, Primitive, RunInfo, S
+from dial.scheduler.primitive import Ended, Primitive
+from dial.scheduler.types import RunInfo, S
 
 
 class ActiveRun(Generic[S]):
@@ -46,11 +47,4 @@ class RunPlan(NamedTuple):
     def of(cls, info: RunInfo) -> RunPlan:
         event = info.event
         fixed = event.instruction.length == "fixed"
-        timeout = event.args.get("timeout")
-        usable = not fixed and isinstance(timeout, int | float)
-        return cls(
-            info,
-            info.span,
-            fixed,
-            float(timeout) if usable else None,  # type: ignore[arg-type]
-        )
+        return cls(info, info.span, fixed, None if fixed else event.args.time_limit())

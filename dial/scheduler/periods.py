@@ -26,9 +26,10 @@ from dial.parser.script import Run, Script
 from dial.robot.protocol import Clocked, Course, Fired, Report
 from dial.scheduler.active import ActiveRun
 from dial.scheduler.position import Hooks, Resume
+from dial.scheduler.primitive import Ended, Now, Outcome
 from dial.scheduler.records import Records
 from dial.scheduler.signals import StopRequest
-from dial.scheduler.types import Ended, Interrupted, Now, Outcome, RunAborted, S
+from dial.scheduler.types import Interrupted, RunAborted, S
 
 ABORT_ON = frozenset({Outcome.TIMEOUT, Outcome.ERROR})
 OUTCOME_TEXT = {o: o.value for o in Outcome}  # a dict lookup is cheaper than Enum.value

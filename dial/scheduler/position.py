@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, NamedTuple, Protocol
 from dial.parser.script import Run, Script, TBlock
 
 if TYPE_CHECKING:
-    from dial.scheduler.types import Outcome
+    from dial.scheduler.primitive import Outcome
 
 
 class Frame(NamedTuple):

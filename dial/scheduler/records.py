@@ -12,7 +12,7 @@ from dial.parser.ast import Condition
 from dial.parser.script import Run
 from dial.robot.protocol import Happening
 from dial.scheduler.log import DIGITS, EventLog, Record, clean
-from dial.scheduler.types import Ended, Outcome
+from dial.scheduler.primitive import Ended, Outcome
 
 _OUTCOME_TEXT = {o: o.value for o in Outcome}  # a dict lookup is cheaper than Enum.value
 

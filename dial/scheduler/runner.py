@@ -30,17 +30,11 @@ from dial.parser.script import (
 from dial.robot.protocol import Clocked
 from dial.scheduler.log import EventLog
 from dial.scheduler.position import Frame, Hooks, Path, Resume
+from dial.scheduler.primitive import Outcome
 from dial.scheduler.records import Records
 from dial.scheduler.signals import StopRequest, catch_stop_signals
 from dial.scheduler.ticks import Observe, Progress, TickLoop
-from dial.scheduler.types import (
-    Interrupted,
-    Outcome,
-    PrimitiveFactory,
-    RunAborted,
-    S,
-    periods_per_tick,
-)
+from dial.scheduler.types import Interrupted, PrimitiveFactory, RunAborted, S, periods_per_tick
 
 Ending = TResume | TRetry | TAbort  # how a reaction ends, once one of these is executed
 

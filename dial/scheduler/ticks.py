@@ -10,17 +10,17 @@ from __future__ import annotations
 
 from collections import defaultdict
 from dataclasses import dataclass
-from typing import NamedTuple, cast
+from typing import NamedTuple
 
 from dial.errors import DialError
-from dial.instructions.catalogue import contact_condition
 from dial.parser.script import Run, Script, TBlock, TOn, Watch
 from dial.robot.protocol import Clocked, Course, Fired, Monitor
 from dial.scheduler.active import ActiveRun, RunPlan
 from dial.scheduler.periods import ABORT_ON, Observe, Periods, Progress
+from dial.scheduler.primitive import Ended, Outcome, Sensor
 from dial.scheduler.records import Records
 from dial.scheduler.signals import StopRequest
-from dial.scheduler.types import Ended, Outcome, Primitive, PrimitiveFactory, RunInfo, S, Sensor
+from dial.scheduler.types import PrimitiveFactory, RunInfo, S
 
 __all__ = ["Observe", "Preempted", "Progress", "TickLoop"]
 
@@ -176,14 +176,15 @@ class TickLoop(Periods[S]):
     def _start(self, script: Script, run: Run) -> None:
         """Start a run in line order; a sensing run happens at once."""
         plan = self._run_plan(script, run)
-        prim = self.factory(plan.info)
         self.counts["runs"] += 1
-        self.records.start(script.path, run, self.tick, self.sim_time)
         if plan.info.event.instruction.length == "zero":
-            self._sense(script, run, cast("Sensor[S]", prim))
+            sensor = self.factory.sensor(plan.info)
+            self.records.start(script.path, run, self.tick, self.sim_time)
+            self._sense(script, run, sensor)
             return
-        prim_s = cast("Primitive[S]", prim)  # quoted: Primitive[S] at run time costs 0.3 us
-        active = ActiveRun(script, plan, prim_s, self.tick, self.periods, self.clock)
+        prim = self.factory.primitive(plan.info)
+        self.records.start(script.path, run, self.tick, self.sim_time)
+        active = ActiveRun(script, plan, prim, self.tick, self.periods, self.clock)
         self.active.append(active)  # from here on, its stop runs whatever happens
         try:
             active.prim.start(self._snapshot())
@@ -192,9 +193,8 @@ class TickLoop(Periods[S]):
 
     def sense(self, script: Script, run: Run) -> None:
         """Sense a condition-only event now, with zero duration (no start record)."""
-        info = RunInfo(script.events[run.event], run, script.path, self.n, self.period, True)
-        sensor = cast("Sensor[S]", self.factory(info))
-        self._sense(script, run, sensor)
+        info = RunInfo(script.events[run.event], run, script.path, self.n, self.period)
+        self._sense(script, run, self.factory.sensor(info))
 
     def _sense(self, script: Script, run: Run, sensor: Sensor[S]) -> None:
         try:
@@ -227,12 +227,10 @@ class TickLoop(Periods[S]):
     def _watch(
         self, script: Script, block: TBlock, watch: Watch, monitors: dict[int, tuple[int, Watch]]
     ) -> None:
-        event = script.events[watch.event]
         for index, on in enumerate(block.reactions):
             if on.condition.event == watch.event:
-                contact = contact_condition(event.instruction, event.args)
-                key = self.robot.watch(Monitor(event.name, contact, on.condition.negated))
-                monitors[key] = (index, watch)
+                monitor = Monitor(watch.event, watch.contact, on.condition.negated)
+                monitors[self.robot.watch(monitor)] = (index, watch)
 
     def _unwatch(self, monitors: dict[int, tuple[int, Watch]], watch: Watch) -> None:
         for key in [k for k, (_, w) in monitors.items() if w is watch]:

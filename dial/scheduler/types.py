@@ -1,29 +1,23 @@
-"""The contract between the runner, the primitives and the robot.
+"""What the runner knows of a run's place in the script, and how a script stops early.
 
 The runner knows nothing of MuJoCo: it drives a robot's :class:`~dial.robot.protocol.Clocked`
-face over a snapshot type ``S`` of the robot's choosing, and builds a :class:`Primitive` (or
-a :class:`Sensor`, for zero-length sensing) per run through a :data:`PrimitiveFactory`.
+face over a snapshot type ``S`` of the robot's choosing, and has each run's
+:class:`~dial.scheduler.primitive.Primitive` (or :class:`~dial.scheduler.primitive.Sensor`,
+for zero-length sensing) made through its :class:`Makers`.
 """
 
 from __future__ import annotations
 
 import math
-from abc import ABC, abstractmethod
-from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field
-from enum import StrEnum
-from typing import Generic, NamedTuple, Protocol, TypeVar
+from dataclasses import dataclass
+from typing import Protocol, TypeVar
 
 from dial.errors import DialError
 from dial.parser.script import EventDef, Run
-from dial.robot.protocol import Course
+from dial.scheduler.primitive import Allotment, Primitive, Sensor
 
 S = TypeVar("S")
 S_contra = TypeVar("S_contra", contravariant=True)
-
-# What a run reports for the log: JSON-able values (numbers, strings, lists, arrays).
-Data = Mapping[str, object]
-
 
 DEFAULT_TICK = 0.25  # s, when neither the script (@tick) nor the command line sets one
 
@@ -35,88 +29,6 @@ def periods_per_tick(tick: float, period: float) -> int:
     return round(tick / period)
 
 
-class Outcome(StrEnum):
-    """How a run ended (DESIGN 2.5, 2.7)."""
-
-    DONE = "done"
-    MISSED = "missed"
-    TIMEOUT = "timeout"
-    ERROR = "error"
-    PREEMPTED = "preempted"
-
-
-@dataclass(frozen=True, slots=True)
-class Ended:
-    """A run's outcome, with a message for ``error``, any sensed data to log, and warnings
-    (each becomes a ``warning`` record: a run that did not quite do what was asked never
-    ends silently ``done``)."""
-
-    outcome: Outcome
-    message: str = ""
-    data: Data = field(default_factory=dict)
-    warnings: tuple[str, ...] = ()
-
-
-DONE = Ended(Outcome.DONE)
-
-
-class Now(NamedTuple):
-    """What a primitive knows of time in one control period.
-
-    ``progress`` is the run's progress through its executing ticks in **tick time** (0 at
-    its start, 1 at the end of its last ``#``/``=`` tick); it stands still while a tick is
-    stretched. ``elapsed`` is simulated time since the run started (s), which never does.
-    ``sim_time`` is the simulated time at the end of this period (s).
-    """
-
-    sim_time: float
-    tick: int
-    progress: float
-    elapsed: float
-    stretched: bool
-
-
-class Primitive(ABC, Generic[S_contra]):
-    """One run of an instruction, stepped synchronously by the runner.
-
-    Lifecycle: :meth:`start` once; :meth:`step` every control period until it returns an
-    :class:`Ended` (or, for fixed-length runs, until the runner calls :meth:`finish` at the
-    end of the last executing tick); :meth:`stop` always, exactly once, after the run ends
-    for whatever reason (done, timeout, error, preempted, abort, interrupt). A step reads
-    the immutable snapshot and writes only its own effectors' command slots.
-    """
-
-    def start(self, snapshot: S_contra) -> None:
-        """Plan the run from the snapshot at its first period."""
-
-    @abstractmethod
-    def step(self, snapshot: S_contra, now: Now) -> Ended | None:
-        """Write this period's commands; return an outcome to end the run."""
-
-    def finish(self, snapshot: S_contra) -> Ended:
-        """End a fixed-length run at the end of its last executing tick."""
-        return DONE
-
-    #: An open-loop run's steps read nothing of the snapshot and never end it: its set-points
-    #: are a function of its progress alone, so the runner may take them in one go (coast).
-    open_loop: bool = False
-
-    def course(self, progress: Sequence[float]) -> Course:
-        """An open-loop run's writer of the set-points that :meth:`step` would write in the
-        coming periods, at these progress values (one per period, in order): calling it with
-        ``k`` writes the ``k``-th period's and leaves the run as if stepped through it."""
-        raise NotImplementedError(f"{type(self).__name__} is not open-loop")
-
-    def stop(self) -> None:
-        """Clean up; the effectors keep holding their last command."""
-
-
-class Sensor(Protocol[S_contra]):
-    """A zero-length run or a condition test: sensed at once, at the start of its tick."""
-
-    def sense(self, snapshot: S_contra) -> Ended: ...
-
-
 @dataclass(frozen=True)
 class RunInfo:
     """Where a run sits: its event, block ticks, and the tick length in periods."""
@@ -126,15 +38,28 @@ class RunInfo:
     script: str
     periods_per_tick: int
     period: float
-    instant: bool = False  # sensed once with zero duration (a sensing run or condition test)
 
     @property
     def span(self) -> int:
         """The run's executing ticks, in control periods (a one-tick run's is one tick)."""
         return (self.run.exec_end - self.run.start + 1) * self.periods_per_tick
 
+    @property
+    def allotment(self) -> Allotment:
+        """What the run's primitive is allotted: its effectors and its span."""
+        return Allotment(self.event.effectors, self.span, self.periods_per_tick, self.period)
 
-PrimitiveFactory = Callable[[RunInfo], "Primitive[S] | Sensor[S]"]
+
+class PrimitiveFactory(Protocol[S_contra]):
+    """Makes each run's primitive, or sensor, as its event's instruction declares it."""
+
+    def primitive(self, info: RunInfo) -> Primitive[S_contra]:
+        """A run of a fixed-length or indeterminate instruction."""
+        ...
+
+    def sensor(self, info: RunInfo) -> Sensor[S_contra]:
+        """A zero-length run, or a condition-only event tested once (no start record)."""
+        ...
 
 
 class RunAborted(DialError):

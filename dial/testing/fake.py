@@ -23,8 +23,9 @@ from dial.parser.check import check_text
 from dial.parser.script import Script
 from dial.robot.protocol import Course, Fired, Monitor, Report, StopFlag, advance_through
 from dial.scheduler.log import EventLog, Record
+from dial.scheduler.primitive import Ended, Now, Outcome, Primitive, Sensor
 from dial.scheduler.runner import Runner, RunSummary
-from dial.scheduler.types import Ended, Now, Outcome, Primitive, RunInfo, Sensor
+from dial.scheduler.types import RunInfo
 
 
 class FakeSnapshot(NamedTuple):
@@ -179,16 +180,15 @@ class FakeFactory:
             self._calls[event] = itertools.chain(outs, itertools.repeat(outs[-1]))
         return next(self._calls[event])
 
-    def __call__(self, info: RunInfo) -> Primitive[FakeSnapshot] | Sensor[FakeSnapshot]:
-        name = info.event.name
-        behaviour = self.behaviours.get(name, _DEFAULT)
-        length = info.event.instruction.length
-        if length == "fixed":
+    def primitive(self, info: RunInfo) -> Primitive[FakeSnapshot]:
+        if info.event.instruction.length == "fixed":
             return _Motion(self.robot, info)
-        outcome = self._next(name, behaviour)
-        if length == "zero" or info.instant:
-            return _Sense(outcome, behaviour.message)
-        return _Wait(self.robot, info, behaviour, outcome)
+        behaviour = self.behaviours.get(info.event.name, _DEFAULT)
+        return _Wait(self.robot, info, behaviour, self._next(info.event.name, behaviour))
+
+    def sensor(self, info: RunInfo) -> Sensor[FakeSnapshot]:
+        behaviour = self.behaviours.get(info.event.name, _DEFAULT)
+        return _Sense(self._next(info.event.name, behaviour), behaviour.message)
 
 
 @dataclass

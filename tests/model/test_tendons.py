@@ -124,6 +124,6 @@ def test_differential_tracks_the_load_of_a_pressing_finger(
 def test_catalogue_tension_limit_matches_the_model() -> None:
     # grasp_force thresholds are range-checked at check time against the model's limit.
     from dial.backend.model import RobotIndex, load_model
-    from dial.instructions.catalogue import TENDON_TENSION_LIMIT
+    from dial.instructions.grasp_force import TENDON_TENSION_LIMIT
 
     assert RobotIndex.from_model(load_model()).tension_limit == TENDON_TENSION_LIMIT

@@ -11,6 +11,7 @@ from dial.api import load
 from dial.backend.driver import CONTROL_PERIOD
 from dial.engine.setup import script_world
 from dial.geometry import location_pose
+from dial.instructions.grasp_force import GraspForceArgs
 from dial.preview import preview
 from dial.preview.motions import grasp
 from dial.preview.places import statement_place
@@ -204,7 +205,9 @@ def test_a_grasp_holds_what_its_fingers_touch_and_what_lies_inside_it() -> None:
     for bit, angle in ctx.world.poses["prepit"].angles.items():
         robot.hand_target[bit] = angle
     scene.pose()
-    report = grasp(scene, script.events["grabpit"], lambda: None)
+    args = script.events["grabpit"].args
+    assert isinstance(args, GraspForceArgs)
+    report = grasp(scene, lambda: None, args.jmask, args.tmask)
     assert report.outcome.value == "done"
     (grip,) = scene.held
     names = {scene.model.body(b).name for b in grip.bodies}

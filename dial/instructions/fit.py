@@ -1,0 +1,72 @@
+"""``fit_plane [SET]`` and ``fit_superquadric [SET]``: least-squares fits to a point set
+(:mod:`dial.haptics`); their results (normal, residual, extents; size, shape exponents and
+pose) go to the log and the summary.
+
+Sensed by :class:`dial.primitives.sensing.Fit`; the preview has them ``done``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+from dial.instructions.base import Args, Instruction, ParamSpec
+from dial.instructions.types import Name
+
+if TYPE_CHECKING:
+    from dial.preview.moves import Move
+    from dial.primitives.context import Context
+    from dial.robot.snapshot import Snapshot
+    from dial.scheduler.primitive import Sensor
+
+_SET = ParamSpec("set", Name("set"), "contacts", positional=True)
+
+
+@dataclass(frozen=True)
+class _FitArgs(Args):
+    """``set``: the point set fitted."""
+
+    set: str
+
+    def preview(self) -> Move:
+        from dial.preview.moves import Sensed
+
+        return Sensed()
+
+
+@dataclass(frozen=True)
+class FitPlaneArgs(_FitArgs):
+    def sensor(self, ctx: Context) -> Sensor[Snapshot]:
+        from dial.haptics import fit_plane
+        from dial.primitives.sensing import Fit
+
+        return Fit(ctx, self.set, fit_plane)
+
+
+@dataclass(frozen=True)
+class FitSuperquadricArgs(_FitArgs):
+    def sensor(self, ctx: Context) -> Sensor[Snapshot]:
+        from dial.haptics import fit_superquadric
+        from dial.primitives.sensing import Fit
+
+        return Fit(ctx, self.set, fit_superquadric)
+
+
+FIT_PLANE = Instruction(
+    "fit_plane",
+    "zero",
+    (_SET,),
+    lambda v: FitPlaneArgs(v[_SET]),
+    "fit_plane [SET]",
+    "Least-squares plane through a point set: normal, residual, extents.",
+    sensing=True,
+)
+FIT_SUPERQUADRIC = Instruction(
+    "fit_superquadric",
+    "zero",
+    (_SET,),
+    lambda v: FitSuperquadricArgs(v[_SET]),
+    "fit_superquadric [SET]",
+    "Least-squares superquadric through a point set: size, shape exponents, pose.",
+    sensing=True,
+)
