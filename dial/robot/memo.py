@@ -160,7 +160,14 @@ def _read(fingerprint: str) -> dict[Key, Stored]:
         return {}  # none yet, unreadable or damaged: solve again
     if not isinstance(found, dict):
         return {}
-    return {k: v for k, v in found.items() if isinstance(k, tuple) and isinstance(v, bytes | tuple)}
+    return {k: v for k, v in found.items() if isinstance(k, tuple) and _whole(v)}
+
+
+def _whole(value: object) -> bool:
+    """Whether ``value`` is as :func:`_stored` writes one: whole float64s, or floats."""
+    if isinstance(value, bytes):
+        return len(value) % 8 == 0
+    return isinstance(value, tuple) and all(type(x) is float for x in value)
 
 
 def _write(path: Path, data: bytes) -> None:

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import copy
 import json
+import marshal
 import os
 import subprocess
 import sys
@@ -52,6 +53,10 @@ def test_a_damaged_file_is_a_miss_and_is_written_again(cache: Path) -> None:
     damaged = memo.Memo("d" * 32)
     key = memo.memo_key("arm-track", np.ones(3))
     assert damaged.get(key) is None
+    odd = {key: b"\x00" * 7, memo.memo_key("arm-solve", np.ones(3)): ("far", 0.5)}
+    path.write_bytes(marshal.dumps(odd))  # marshal's, but not as the memo writes them
+    assert memo.Memo("d" * 32).get(key) is None
+    assert memo.Memo("d" * 32).get(memo.memo_key("arm-solve", np.ones(3))) is None
     damaged.put(key, np.ones(6))
     damaged.save()
     assert isinstance(memo.Memo("d" * 32).get(key), np.ndarray)
