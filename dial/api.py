@@ -15,7 +15,7 @@ from __future__ import annotations
 import math
 import os
 import sys
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Iterator, Sequence
 from contextlib import contextmanager, suppress
 from pathlib import Path
 from typing import TYPE_CHECKING, TextIO
@@ -32,9 +32,8 @@ if TYPE_CHECKING:  # trio and MuJoCo load only to run: `import dial` and checkin
     from dial.debug import Break, Console
     from dial.disturb import Disturbance
     from dial.engine import Observer, RunResult
-    from dial.engine.state import Saved
-
-Progress = Callable[[int, float, list[str]], None]
+    from dial.engine.state import StateFile
+    from dial.scheduler.periods import Progress
 
 
 def load(path: str | Path, *, scene: str | None = None) -> Script:
@@ -172,7 +171,7 @@ def _checked(
     disturb: Sequence[str | Disturbance],
     save_at: tuple[int, str | Path] | None,
     resume: str | Path | None,
-) -> tuple[list[Disturbance], Saved | None]:
+) -> tuple[list[Disturbance], StateFile | None]:
     """The option checks that need no script: ranges, SPECs, the state files."""
     from dial.disturb import parse_disturbance
 
@@ -268,7 +267,7 @@ def _watchers(
     return watchers
 
 
-def _load_state(path: Path) -> Saved:
+def _load_state(path: Path) -> StateFile:
     from dial.engine.state import load as load_state  # MuJoCo loads only to run
 
     return load_state(path)

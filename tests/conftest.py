@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import atexit
+import importlib.util
 import json
 import os
 import shutil
@@ -25,6 +26,20 @@ UPDATE = os.environ.get("DIAL_UPDATE_GOLDEN") == "1"
 if "DIAL_CACHE" not in os.environ:
     os.environ["DIAL_CACHE"] = tempfile.mkdtemp(prefix="dial-test-cache-")
     atexit.register(shutil.rmtree, os.environ["DIAL_CACHE"], True)
+
+
+def needs(extra: str, *modules: str) -> pytest.MarkDecorator:
+    """Skip a test, saying why, when an optional extra it needs is not installed."""
+    missing = [m for m in modules if importlib.util.find_spec(m) is None]
+    reason = (
+        f"the '{extra}' extra is not installed ({', '.join(missing)}): pip install -e '.[{extra}]'"
+    )
+    return pytest.mark.skipif(bool(missing), reason=reason)
+
+
+NEEDS_PLOT = needs("plot", "matplotlib")
+NEEDS_VIDEO = needs("video", "imageio", "imageio_ffmpeg")
+NEEDS_RAY = needs("ray", "ray")
 
 
 def golden(path: Path, actual: str) -> None:

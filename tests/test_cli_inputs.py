@@ -14,6 +14,8 @@ import pytest
 
 from dial.cli import main
 
+from .conftest import NEEDS_PLOT, NEEDS_VIDEO
+
 DIAL = [sys.executable, "-m", "dial.cli"]
 
 # (arguments, exit status, how the first line of stderr starts)
@@ -35,7 +37,12 @@ RUN_CASES = [
     (["--log", "/tmp"], 1, "dial: cannot write the log: '/tmp' is a directory"),
     (["--log", "/dev/full"], 1, "dial: cannot write the log: No space left on device"),
     (["--log", "/proc/x.jsonl"], 1, "dial: cannot write the log: No such file or directory"),
-    (["--video", "/proc/x.mp4"], 1, "dial: cannot write the video: No such file or directory"),
+    pytest.param(
+        ["--video", "/proc/x.mp4"],
+        1,
+        "dial: cannot write the video: No such file or directory",
+        marks=NEEDS_VIDEO,  # without the extra, that is said first
+    ),
     (["--record", "/proc/x.rrd"], 1, "dial: cannot write the recording: No such file"),
     (["--record", "x.mp4"], 2, "dial: --record writes a .rrd file, not 'x.mp4'"),
     (["--video", "x.avi"], 2, "dial: --video writes .mp4 or .gif files"),
@@ -159,6 +166,7 @@ def test_world_of_a_latin1_world_file(tmp_path: Path, capsys: pytest.CaptureFixt
     assert capsys.readouterr().err == f"dial: {path}: not UTF-8 text (byte 25); TOML is UTF-8\n"
 
 
+@NEEDS_PLOT  # without the extra, that is said first
 def test_teach_snapshot_into_a_folder_it_cannot_make(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

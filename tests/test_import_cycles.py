@@ -87,3 +87,23 @@ def test_the_graph_sees_type_checking_relative_and_package_imports(tmp_path: Pat
 def test_no_import_cycle_inside_dial() -> None:
     cycle = find_cycle(import_graph())
     assert cycle is None, "import cycle: " + " -> ".join(cycle or [])
+
+
+def test_primitives_see_the_robot_only_through_its_seam() -> None:
+    # A primitive reads its snapshot and the robot's read-only view and writes its slots
+    # (dial.robot): it imports neither MuJoCo nor a backend module, nor the engine.
+    found = {}
+    for path in sorted((PACKAGE / "primitives").glob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            names = (
+                [a.name for a in node.names]
+                if isinstance(node, ast.Import)
+                else [node.module or ""]
+                if isinstance(node, ast.ImportFrom)
+                else []
+            )
+            bad = [n for n in names if n.split(".")[0] in ("mujoco", "mink")]
+            bad += [n for n in names if n.startswith(("dial.backend", "dial.engine"))]
+            if bad:
+                found[path.name] = bad
+    assert found == {}

@@ -4,6 +4,11 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
+import pytest
+
+pytest.importorskip(
+    "hypothesis", reason="the 'test' extra is not installed: pip install -e '.[test]'"
+)
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 

@@ -15,6 +15,7 @@ from dial.scheduler import Outcome
 from dial.scheduler.log import EventLog
 from dial.scheduler.primitive import Ended, Now, Primitive
 from dial.scheduler.runner import Runner
+from dial.scheduler.signals import catch_stop_signals
 from dial.scheduler.types import RunInfo
 from dial.testing import Behaviour, FakeFactory, FakeRobot, run_fake
 
@@ -276,8 +277,10 @@ def test_ctrl_c_stops_the_run_at_a_checkpoint_with_the_arm_held(tick: int) -> No
         def primitive(self, info: RunInfo) -> Primitive:
             return _CtrlC() if info.event.name == "pose" else super().primitive(info)
 
-    runner = Runner(robot, Factory(robot, {}), 0.1, log)
-    summary = trio.run(runner.run, script, clock=trio.testing.MockClock(autojump_threshold=0))
+    clock = trio.testing.MockClock(autojump_threshold=0)
+    with catch_stop_signals() as stop:  # who starts a run owns the signals; the runner polls
+        runner = Runner(robot, Factory(robot, {}), 0.1, log, stop=stop)
+        summary = trio.run(runner.run, script, clock=clock)
     assert summary.interrupted == "SIGINT" and not summary.ok
     assert robot.held
     last = log.records[-1]

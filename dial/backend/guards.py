@@ -2,9 +2,9 @@
 
 A **guard** belongs to a guarded move: when it trips, the driver freezes the guarded
 effector at that physics step. A **monitor** belongs to a watched span (DESIGN 2.7): it
-freezes nothing; the runner preempts the block. Both read the same contact readings as a
-contact wait does (:func:`~dial.robot.contact.contact_reading`), so a guard, a monitor
-and a wait mean the same contact.
+freezes nothing; the runner preempts the block. Both read the contact readings of
+:mod:`dial.robot.contact`, as a contact wait does, so a guard, a monitor and a wait mean
+the same contact.
 """
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ import mujoco
 import numpy as np
 
 from dial.backend.model import RobotIndex, tendon_tensions
-from dial.robot.contact import POSITION_LEVER
+from dial.robot.contact import force_reading, position_reading, tactile_reading
 from dial.robot.snapshot import FloatArray, Trip
 
 
@@ -28,7 +28,7 @@ class Guard:
     effector: str | None
     conditions: tuple[tuple[str, float], ...]
     sense: tuple[int, ...]
-    baseline: FloatArray  # (16,) differentials when armed, for force conditions
+    baseline: FloatArray  # (16,) differentials when added, for force conditions
     negated: bool = False
     floats: tuple[float, ...] = field(init=False, repr=False)  # baseline, read every step
 
@@ -38,9 +38,9 @@ class Guard:
 
 class Readings:
     """What guards and monitors read at one physics step, computed only as far as they need
-    (this runs after every physics step while one is armed). The formulas are
-    :func:`~dial.robot.contact.contact_reading`'s; a dropped-out sensor reads 0. One per
-    robot: :meth:`at_step` starts each step afresh."""
+    (this runs after every physics step while one is tested), each once per step: the
+    readings of :mod:`dial.robot.contact`; a dropped-out sensor reads 0. One per robot:
+    :meth:`at_step` starts each step afresh."""
 
     __slots__ = (
         "_data", "_diff", "_dropped", "_index", "_q", "_tactile", "_target",
@@ -71,29 +71,23 @@ class Readings:
         """The reading of contact ``kind`` on finger ``f``: m (tactile, position) or N."""
         if self._dropped and (kind, f) in self._dropped:
             return 0.0
-        if kind == "tactile":
-            # The deepest taxel, once per finger and step; argmax costs a quarter of max.
+        if kind == "tactile":  # once per finger and step
             tips = self._tips
             if tips is None:
                 tips = self._tips = [None] * len(self._tactile)
             tip = tips[f]
             if tip is None:
-                row = self._tactile[f]
-                tip = tips[f] = float(row.item(row.argmax()))
+                tip = tips[f] = tactile_reading(self._tactile[f])
             return tip
-        if kind == "force":
-            # The largest change of a finger's four differentials since the guard was armed,
-            # in Python floats: the tensions are read once per step, whatever the guards.
+        if kind == "force":  # the tensions are read once per step, whatever the guards
             if self._diff is None:
                 view = self._tensions
                 tensions = view if view is not None else tendon_tensions(self._data, self._index)
                 self._diff = tensions.tolist()
-            t: list[float] = self._diff
-            return max(abs(t[2 * k] - t[2 * k + 1] - baseline[k]) for k in range(4 * f, 4 * f + 4))
+            return force_reading(self._diff, baseline, f)
         if self._q is None:
             self._q = self._data.qpos[self._index.hand_qpos]
-        joints = slice(4 * f, 4 * f + 4)
-        return float(np.linalg.norm(self._target[joints] - self._q[joints])) * POSITION_LEVER
+        return position_reading(self._target, self._q, f)
 
 
 def first_trip(guard: Guard, r: Readings, time: float, step: int) -> Trip | None:

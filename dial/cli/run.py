@@ -8,8 +8,8 @@ import sys
 from collections.abc import Callable
 from typing import TYPE_CHECKING
 
-from dial.cli.common import UsageError, load_script, scene_argument
-from dial.scheduler.signals import EXIT_STATUS, StopRequest, catch_stop_signals
+from dial.cli.common import UsageError, scene_argument
+from dial.scheduler.signals import EXIT_STATUS, catch_stop_signals
 
 if TYPE_CHECKING:  # what a run needs loads when it runs: `dial --help` stays quick
     from dial.engine import RunResult
@@ -112,26 +112,22 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
 
 
 def cmd_run(args: argparse.Namespace) -> int:
-    # From here to the exit, a stop signal stops the run (which catches it first) or, once
-    # the run is over, is ignored: a second Ctrl-C cannot cut the summary or the log short.
-    stop = StopRequest()
-    with catch_stop_signals(stop):
-        return _run(args, stop)
+    # The command owns the stop signals from here to the exit: one stops the run (dial.run
+    # checks the options, then the script, then runs it) or, once the run is over, is
+    # ignored: a second Ctrl-C cannot cut the summary or the log short.
+    with catch_stop_signals():
+        return _run(args)
 
 
-def _run(args: argparse.Namespace, stop: StopRequest) -> int:
+def _run(args: argparse.Namespace) -> int:
     from dial import api  # the parser and the engine: not for --help
 
     if args.log_states and not args.log:
         raise UsageError("--log-states writes into the log: give --log FILE.jsonl too")
-    api.check_options(args.tick, args.speed, args.seed, args.perturb)
     save_at = _save_at(args.save_at)
-    script = load_script(args.script, args.scene)
-    if stop.signal is not None:  # while the script was being checked
-        print(f"dial: interrupted by {stop.signal}", file=sys.stderr)
-        return EXIT_STATUS[stop.signal]
     result = api.run(
-        script,
+        args.script,
+        scene=args.scene,
         tick=args.tick,
         speed=args.speed,
         seed=args.seed,

@@ -16,7 +16,7 @@ from pathlib import Path
 from dial.debug.breaks import Break
 from dial.debug.console import Console
 from dial.parser.script import Run, Script, TBlock
-from dial.scheduler.position import Path as TimelinePath
+from dial.scheduler.position import TimelinePath
 from dial.scheduler.signals import StopRequest
 
 HELP = """\

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -13,15 +13,14 @@ from dial.engine import state
 from dial.engine.observe import Observer
 from dial.parser.script import Script
 from dial.primitives.context import Context
-from dial.scheduler.position import Path as TimelinePath
-from dial.scheduler.runner import Runner
+from dial.scheduler.position import TimelinePath
 from dial.scheduler.signals import StopRequest
 from dial.scheduler.ticks import TickLoop
 
 
 def session(
     top: Script,
-    runner: Runner[Any],
+    loop_of: Callable[[], TickLoop[Any] | None],
     robot: MujocoRobot,
     ctx: Context,
     stop: StopRequest,
@@ -32,15 +31,21 @@ def session(
     step: bool,
     save_at: tuple[int, Path] | None,
 ) -> Session:
-    """A session whose ``state`` reads this robot and whose ``save`` writes state files."""
+    """A session whose ``state`` reads this robot and whose ``save`` writes state files;
+    ``loop_of()``: the runner's tick loop, once the run has started (the hooks are called
+    only then)."""
+
+    def loop() -> TickLoop[Any]:
+        running = loop_of()
+        assert running is not None, "a hook is called while the run goes on"
+        return running
 
     def where() -> str:
-        assert runner.loop is not None
-        return f"tick {runner.loop.tick}, t = {runner.loop.sim_time:.3f} s"
+        return f"tick {loop().tick}, t = {loop().sim_time:.3f} s"
 
     def save(target: Path, number: int, path: TimelinePath, script: Script) -> None:
-        assert runner.loop is not None  # the path runs from the top script, whoever's block
-        state.save(target, top, path, number - 1, runner.loop, robot, ctx, settings)
+        # The path runs from the top script, whoever's block it is.
+        state.save(target, top, path, number - 1, loop(), robot, ctx, settings)
 
     def on_pause() -> None:  # the viewers show the paused state
         for observer in observers:
@@ -49,8 +54,7 @@ def session(
                 show()
 
     def describe() -> str:
-        assert runner.loop is not None
-        return state_text(paused_view(top, runner.loop, robot))
+        return state_text(paused_view(top, loop(), robot))
 
     return Session(
         stop, console, breaks, step, save_at, save, describe, where, on_pause, top=top.path

@@ -10,7 +10,7 @@ import mujoco
 from dial.scene.evaluate import measure
 from dial.scene.world import World
 from dial.scheduler.log import EventLog, Record
-from dial.scheduler.runner import RunSummary
+from dial.scheduler.runner import Tally
 
 
 @dataclass(frozen=True)
@@ -46,7 +46,7 @@ class RunResult:
     ``results``: the fits by point-set name. ``log``: every record, in order.
     """
 
-    summary: RunSummary
+    summary: Tally
     world: World
     criteria: Criteria
     results: dict[str, dict[str, object]]

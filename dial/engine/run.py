@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, TextIO
@@ -17,11 +17,11 @@ from typing import TYPE_CHECKING, TextIO
 import trio
 
 from dial.backend.driver import MujocoRobot
-from dial.disturb import Disturbance, parse_disturbance
+from dial.disturb import Disturbance
 from dial.engine.observe import Observer, StateLog, Watched, describe, fan_out, first_line
 from dial.engine.result import RunResult, measure_criteria
 from dial.engine.setup import Factory, prepare
-from dial.engine.state import RunSettings, Saved
+from dial.engine.state import RunSettings, StateFile
 from dial.errors import DialError, OptionError
 from dial.parser.lanes import LanePlan
 from dial.parser.script import Script
@@ -31,7 +31,7 @@ from dial.scheduler.log import EventLog
 from dial.scheduler.position import Resume
 from dial.scheduler.runner import Runner
 from dial.scheduler.signals import StopRequest, catch_stop_signals
-from dial.scheduler.ticks import Progress
+from dial.scheduler.ticks import Progress, TickLoop
 from dial.scheduler.types import DEFAULT_TICK
 
 if TYPE_CHECKING:  # a run that pauses or saves brings the debugger: others do without it
@@ -59,21 +59,22 @@ class RunOptions:
     step: bool = False
     console: Console | None = None
     save_at: tuple[int, Path] | None = None  # (block number, state file)
-    resume: Saved | None = None  # a state file to go on from (its settings win)
+    resume: StateFile | None = None  # a state file to go on from (its settings win)
 
 
 def tick_length(script: Script, options: RunOptions) -> float:
-    """The tick the run uses, in s: ``--tick``, else ``@tick``, else the default; / speed."""
+    """The tick the run uses, in s: ``--tick``, else ``@tick``, else the default; / speed.
+
+    The options alone are checked once, by :func:`dial.api.run`; here only what depends on
+    the script too: ``@tick`` divided by ``--speed`` may leave the range."""
     tick = options.tick if options.tick is not None else (script.tick or DEFAULT_TICK)
-    if not (math.isfinite(options.speed) and options.speed > 0):
-        raise OptionError(f"--speed must be a positive number, got {options.speed:g}")
-    if not (math.isfinite(tick) and 0 < tick / options.speed <= MAX_TICK):
+    length = tick / options.speed if options.speed > 0 else math.inf
+    if not (math.isfinite(length) and 0 < length <= MAX_TICK):
         by = f" (--speed {options.speed:g})" if options.speed != 1.0 else ""
         raise OptionError(
-            f"the tick must be above 0 s and at most {MAX_TICK:g} s, got "
-            f"{tick / options.speed:g} s{by}"
+            f"the tick must be above 0 s and at most {MAX_TICK:g} s, got {length:g} s{by}"
         )
-    return tick / options.speed
+    return length
 
 
 def run(script: Script, options: RunOptions) -> RunResult:
@@ -82,13 +83,13 @@ def run(script: Script, options: RunOptions) -> RunResult:
     SIGINT and SIGTERM stop the run at the next control period, from the scene's loading on:
     every effector holds, and the log ends with ``interrupted`` and ``summary``.
     """
-    stop = StopRequest()
-    with catch_stop_signals(stop):
+    with catch_stop_signals() as stop:
         log = EventLog(options.log)
         settings = _settings(script, options)
-        disturb = [parse_disturbance(d) for d in settings.disturb]
         drawn = bool(options.observers)  # an observer may draw: it gets the scene's textures
-        robot, ctx = prepare(script, log, settings.perturb_mm, settings.seed, disturb, drawn)
+        robot, ctx = prepare(
+            script, log, settings.perturb_mm, settings.seed, settings.disturb, drawn
+        )
         resume = _resume(script, options.resume, robot, ctx, log)
         states = [StateLog(lanes=LanePlan.from_script(script))] if options.log_states else []
         begun: list[Observer] = []
@@ -97,6 +98,12 @@ def run(script: Script, options: RunOptions) -> RunResult:
             for observer in states + list(options.observers):
                 observer.begin(Watched(robot, ctx.world, log))
                 begun.append(observer)
+            runner: Runner[Snapshot]
+
+            def loop_of() -> TickLoop[Snapshot] | None:  # called once the run has started
+                return runner.loop
+
+            hooks = _debugging(script, loop_of, robot, ctx, stop, settings, begun, options)
             runner = Runner(
                 robot,
                 Factory(ctx),
@@ -106,9 +113,7 @@ def run(script: Script, options: RunOptions) -> RunResult:
                 observe=fan_out(begun),
                 pace=1.0 if options.realtime else None,
                 stop=stop,
-            )
-            hooks = runner.hooks = _debugging(
-                script, runner, robot, ctx, stop, settings, begun, options
+                hooks=hooks,
             )
             start, cpu = time.perf_counter(), time.process_time()
             summary = trio.run(runner.run, script, resume)
@@ -123,7 +128,7 @@ def run(script: Script, options: RunOptions) -> RunResult:
                 robot.steps,
                 log,
                 [float(x) for x in robot.data.qpos],
-                settings.disturb,
+                tuple(d.text for d in settings.disturb),
                 tuple(hooks.saved) if hooks is not None else (),
                 hooks.unsaved if hooks is not None else None,
             )
@@ -134,7 +139,7 @@ def run(script: Script, options: RunOptions) -> RunResult:
 
 
 def _resume(
-    script: Script, saved: Saved | None, robot: MujocoRobot, ctx: Context, log: EventLog
+    script: Script, saved: StateFile | None, robot: MujocoRobot, ctx: Context, log: EventLog
 ) -> Resume | None:
     """Put a saved state back (checking the script against it) and log the ``resume``."""
     if saved is None:
@@ -159,13 +164,13 @@ def _settings(script: Script, options: RunOptions) -> RunSettings:
         tick_length(script, options),
         options.seed,
         options.perturb_mm,
-        tuple(d.text for d in options.disturb),
+        tuple(options.disturb),
     )
 
 
 def _debugging(
     script: Script,
-    runner: Runner[Snapshot],
+    loop_of: Callable[[], TickLoop[Snapshot] | None],
     robot: MujocoRobot,
     ctx: Context,
     stop: StopRequest,
@@ -180,7 +185,7 @@ def _debugging(
 
     return session(
         script,
-        runner,
+        loop_of,
         robot,
         ctx,
         stop,

@@ -26,12 +26,12 @@ import mujoco
 import numpy as np
 
 from dial.backend.driver import MujocoRobot
+from dial.disturb import Disturbance, parse_disturbance
 from dial.errors import DialError
 from dial.parser.script import Script, Step, TBlock, TCall, TIf, TRepeat, scripts_of
 from dial.primitives.context import Context
 from dial.robot.snapshot import Touch
-from dial.scheduler.position import Frame, Resume
-from dial.scheduler.position import Path as TimelinePath
+from dial.scheduler.position import Frame, Resume, TimelinePath
 from dial.scheduler.primitive import Outcome
 from dial.scheduler.ticks import TickLoop
 
@@ -63,7 +63,7 @@ class RunSettings:
     tick: float
     seed: int
     perturb_mm: float
-    disturb: tuple[str, ...]
+    disturb: tuple[Disturbance, ...]
 
 
 def _array(values: np.ndarray) -> str:
@@ -174,7 +174,7 @@ def save(
             "tick": settings.tick,
             "seed": settings.seed,
             "perturb_mm": settings.perturb_mm,
-            "disturb": list(settings.disturb),
+            "disturb": [d.text for d in settings.disturb],
         },
         "clock": {"periods": loop.periods, "clock": loop.clock, "tick": loop.tick},
         "latest": [[_key(script, s), e, o.value] for (s, e), o in loop.latest.items()],
@@ -201,7 +201,7 @@ def save(
 
 
 @dataclass(frozen=True)
-class Saved:
+class StateFile:
     """A state file as read: call :meth:`resume` on the script to go on with it."""
 
     source: Path
@@ -304,7 +304,7 @@ class Saved:
                 ctx.believed[body] = (_floats(pos, 3, f"believed {body}"), ctx.believed[body][1])
 
 
-def load(source: Path) -> Saved:
+def load(source: Path) -> StateFile:
     """Read a state file; a one-line :class:`StateFileError` if it is not one dial can use."""
     try:
         data = json.loads(source.read_text(encoding="utf-8"))
@@ -321,9 +321,8 @@ def load(source: Path) -> Saved:
         )
     try:
         s = data["settings"]
-        settings = RunSettings(
-            float(s["tick"]), int(s["seed"]), float(s["perturb_mm"]), tuple(map(str, s["disturb"]))
-        )
+        disturb = tuple(parse_disturbance(str(text)) for text in s["disturb"])
+        settings = RunSettings(float(s["tick"]), int(s["seed"]), float(s["perturb_mm"]), disturb)
         for key in (
             "script",
             "block",
@@ -345,4 +344,4 @@ def load(source: Path) -> Saved:
             raise ValueError(f"block {data['block']!r}")
     except (KeyError, TypeError, ValueError) as e:
         raise StateFileError(f"state file '{source}' is corrupt or truncated ({e})") from None
-    return Saved(source, data, settings)
+    return StateFile(source, data, settings)

@@ -15,17 +15,17 @@ from dial.instructions.scene_names import SceneNames
 from dial.instructions.types import ARM, Choice, Quantity
 
 if TYPE_CHECKING:
-    from dial.preview.moves import Making, Move
+    from dial.preview.moves import Making, PreviewMove
     from dial.preview.scene import Scene
     from dial.primitives.arm import ArmMove
     from dial.primitives.context import Context
     from dial.robot.snapshot import Snapshot
     from dial.scheduler.primitive import Allotment, Primitive
 
-Frame = Literal["tool", "world"]
+FrameName = Literal["tool", "world"]
 _TURN = Quantity("angle", "rad", -6.2832, 6.2832)
 RX, RY, RZ = (ParamSpec(n, _TURN, 0.0, positional=True, doc="rotation") for n in ("rx", "ry", "rz"))
-_FRAME = ParamSpec("frame", Choice[Frame](("tool", "world")), "tool")
+_FRAME = ParamSpec("frame", Choice[FrameName](("tool", "world")), "tool")
 
 
 @dataclass(frozen=True)
@@ -39,7 +39,7 @@ class ArmMoveArgs(Args):
     rx: float
     ry: float
     rz: float
-    frame: Frame
+    frame: FrameName
 
     def effectors(self, scene: SceneNames | None) -> frozenset[str]:
         return frozenset({ARM})
@@ -54,7 +54,7 @@ class ArmMoveArgs(Args):
             ctx, allotted, (self.dx, self.dy, self.dz), (self.rx, self.ry, self.rz), self.frame
         )
 
-    def preview(self) -> Move:
+    def preview(self) -> PreviewMove:
         from dial.preview.checks import arm_plan
         from dial.preview.moves import Stepped
 

@@ -27,7 +27,7 @@ from dial.instructions.scene_names import SceneNames
 from dial.instructions.types import Contact, ContactKind, Finger, ParamType, Quantity
 
 if TYPE_CHECKING:
-    from dial.preview.moves import Move
+    from dial.preview.moves import PreviewMove
     from dial.primitives.context import Context
     from dial.robot.snapshot import Snapshot
     from dial.scheduler.primitive import Allotment, Primitive, Sensor
@@ -104,7 +104,7 @@ class Args:
         """The sensor of a zero-length event, or of a condition-only event's test."""
         raise NotImplementedError(f"{type(self).__name__} is stepped, not sensed")
 
-    def preview(self) -> Move:
+    def preview(self) -> PreviewMove:
         """How ``dial preview`` moves a run of the event (:mod:`dial.preview.moves`)."""
         raise NotImplementedError(f"{type(self).__name__} declares no preview")
 

@@ -2,7 +2,7 @@
 wait until contact is signalled (POSITION, FORCE and TACTILE CONTACT).
 
 The condition holds when the finger's reading reaches the threshold
-(:func:`dial.robot.contact.contact_reading`): its fingertip position error, the change in
+(:mod:`dial.robot.contact`): its fingertip position error, the change in
 its tendon force differentials, or its deepest taxel. In a diagram a run waits for it
 (:class:`dial.primitives.sensing.ContactWait`); as a condition-only event it is tested once
 (:class:`dial.primitives.sensing.ContactTest`); a watched span (``~``) senses it at every
@@ -20,7 +20,7 @@ from dial.instructions.types import Contact, ContactKind, Quantity
 from dial.units import Dimension
 
 if TYPE_CHECKING:
-    from dial.preview.moves import Move
+    from dial.preview.moves import PreviewMove
     from dial.primitives.context import Context
     from dial.robot.snapshot import Snapshot
     from dial.scheduler.primitive import Allotment, Primitive, Sensor
@@ -52,7 +52,7 @@ class ContactArgs(Args):
 
         return ContactTest(self.contact())
 
-    def preview(self) -> Move:
+    def preview(self) -> PreviewMove:
         from dial.preview.moves import Sensed
 
         return Sensed(self.finger)

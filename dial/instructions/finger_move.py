@@ -15,14 +15,14 @@ from dial.instructions.scene_names import SceneNames
 from dial.instructions.types import FINGERS, Choice
 
 if TYPE_CHECKING:
-    from dial.preview.moves import Making, Move
+    from dial.preview.moves import Making, PreviewMove
     from dial.primitives.context import Context
     from dial.primitives.hand import FingerMove
     from dial.robot.snapshot import Snapshot
     from dial.scheduler.primitive import Allotment, Primitive
 
-Frame = Literal["palm", "world"]
-_FRAME = ParamSpec("frame", Choice[Frame](("palm", "world")), "palm")
+FrameName = Literal["palm", "world"]
+_FRAME = ParamSpec("frame", Choice[FrameName](("palm", "world")), "palm")
 
 
 @dataclass(frozen=True)
@@ -34,7 +34,7 @@ class FingerMoveArgs(Args):
     dx: float
     dy: float
     dz: float
-    frame: Frame
+    frame: FrameName
 
     def effectors(self, scene: SceneNames | None) -> frozenset[str]:
         return frozenset({FINGERS[self.finger]})
@@ -47,7 +47,7 @@ class FingerMoveArgs(Args):
 
         return FingerMove(ctx, allotted, self.finger, (self.dx, self.dy, self.dz), self.frame)
 
-    def preview(self) -> Move:
+    def preview(self) -> PreviewMove:
         from dial.preview.checks import finger_goal
         from dial.preview.moves import Stepped
 

@@ -10,11 +10,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-from dial.instructions.base import Args, Instruction, ParamSpec
+from dial.instructions.base import Args, Instruction, ParamSpec, Values
 from dial.instructions.types import Name
 
 if TYPE_CHECKING:
-    from dial.preview.moves import Move
+    from dial.preview.moves import PreviewMove
     from dial.primitives.context import Context
     from dial.robot.snapshot import Snapshot
     from dial.scheduler.primitive import Sensor
@@ -28,7 +28,7 @@ class _FitArgs(Args):
 
     set: str
 
-    def preview(self) -> Move:
+    def preview(self) -> PreviewMove:
         from dial.preview.moves import Sensed
 
         return Sensed()
@@ -52,21 +52,20 @@ class FitSuperquadricArgs(_FitArgs):
         return Fit(ctx, self.set, fit_superquadric)
 
 
-FIT_PLANE = Instruction(
+def _fit(name: str, args: type[_FitArgs], summary: str) -> Instruction:
+    def build(v: Values) -> Args:
+        return args(v[_SET])
+
+    return Instruction(name, "zero", (_SET,), build, f"{name} [SET]", summary, sensing=True)
+
+
+FIT_PLANE = _fit(
     "fit_plane",
-    "zero",
-    (_SET,),
-    lambda v: FitPlaneArgs(v[_SET]),
-    "fit_plane [SET]",
+    FitPlaneArgs,
     "Least-squares plane through a point set: normal, residual, extents.",
-    sensing=True,
 )
-FIT_SUPERQUADRIC = Instruction(
+FIT_SUPERQUADRIC = _fit(
     "fit_superquadric",
-    "zero",
-    (_SET,),
-    lambda v: FitSuperquadricArgs(v[_SET]),
-    "fit_superquadric [SET]",
+    FitSuperquadricArgs,
     "Least-squares superquadric through a point set: size, shape exponents, pose.",
-    sensing=True,
 )

@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 from dial.instructions.base import Args, Instruction, Values
 
 if TYPE_CHECKING:
-    from dial.preview.moves import Move
+    from dial.preview.moves import PreviewMove
     from dial.primitives.context import Context
     from dial.robot.snapshot import Snapshot
     from dial.scheduler.primitive import Sensor
@@ -32,7 +32,7 @@ class _GetArgs(Args):
 
         return Get(self.read)
 
-    def preview(self) -> Move:
+    def preview(self) -> PreviewMove:
         from dial.preview.moves import Sensed
 
         return Sensed()

@@ -16,7 +16,7 @@ from dial.instructions.scene_names import SceneNames
 from dial.instructions.types import MaskPair, Quantity, mask_fingers
 
 if TYPE_CHECKING:
-    from dial.preview.moves import Move
+    from dial.preview.moves import PreviewMove
     from dial.primitives.context import Context
     from dial.robot.snapshot import Snapshot
     from dial.scheduler.primitive import Allotment, Primitive
@@ -62,7 +62,7 @@ class GraspForceArgs(Args):
 
         return GraspForce(ctx, allotted, self.jmask, self.tmask, self.force, self.speed)
 
-    def preview(self) -> Move:
+    def preview(self) -> PreviewMove:
         from functools import partial
 
         from dial.preview.motions import grasp

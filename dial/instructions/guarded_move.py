@@ -16,12 +16,12 @@ from dial.instructions.scene_names import SceneNames
 from dial.instructions.types import ARM, FINGERS, Choice, Conditions, ContactKind, Finger, Quantity
 
 if TYPE_CHECKING:
-    from dial.preview.moves import Move
+    from dial.preview.moves import PreviewMove
     from dial.primitives.context import Context
     from dial.robot.snapshot import Snapshot
     from dial.scheduler.primitive import Allotment, Primitive
 
-Frame = Literal["tool", "palm", "world"]
+FrameName = Literal["tool", "palm", "world"]
 
 _FINGER = ParamSpec[int | None](
     "finger", Finger(), None, doc="move this fingertip (default: the arm)"
@@ -35,7 +35,7 @@ _PRESS = ParamSpec(
     0.0,
     doc="after contact, set the effector this much further on, to keep touching",
 )
-_FRAME = ParamSpec[Frame | None]("frame", Choice[Frame](("tool", "palm", "world")), None)
+_FRAME = ParamSpec[FrameName | None]("frame", Choice[FrameName](("tool", "palm", "world")), None)
 _SPEED = ParamSpec("speed", Quantity("speed", "m/s", 0.0, 1.0, lo_open=True), 0.05)
 
 
@@ -60,7 +60,7 @@ class GuardedMoveArgs(Args):
     sense: int | None
     max: float | None
     press: float
-    frame: Frame | None
+    frame: FrameName | None
     speed: float
     timeout: float
 
@@ -68,7 +68,7 @@ class GuardedMoveArgs(Args):
         return self.timeout
 
     @property
-    def moving_frame(self) -> Frame:
+    def moving_frame(self) -> FrameName:
         """The frame of the direction, its default filled in."""
         return self.frame or ("tool" if self.finger is None else "palm")
 
@@ -107,7 +107,7 @@ class GuardedMoveArgs(Args):
             sense=self.sensed,
         )
 
-    def preview(self) -> Move:
+    def preview(self) -> PreviewMove:
         from functools import partial
 
         from dial.preview.motions import guarded

@@ -15,7 +15,7 @@ from dial.instructions.scene_names import SceneNames
 from dial.instructions.types import ALL_JOINTS, Mask, Name, mask_fingers
 
 if TYPE_CHECKING:
-    from dial.preview.moves import Making, Move
+    from dial.preview.moves import Making, PreviewMove
     from dial.primitives.context import Context
     from dial.primitives.hand import HandPose
     from dial.robot.snapshot import Snapshot
@@ -51,7 +51,7 @@ class HandPoseArgs(Args):
         mask = self.fingers if self.fingers is not None else ALL_JOINTS
         return HandPose(ctx, allotted, self.pose, mask)
 
-    def preview(self) -> Move:
+    def preview(self) -> PreviewMove:
         from dial.preview.checks import hand_pose
         from dial.preview.moves import Stepped
 

@@ -14,7 +14,7 @@ from dial.instructions.scene_names import SceneNames
 from dial.instructions.types import ALL_JOINTS, Mask, Name, mask_fingers
 
 if TYPE_CHECKING:
-    from dial.preview.moves import Making, Move
+    from dial.preview.moves import Making, PreviewMove
     from dial.primitives.context import Context
     from dial.primitives.hand import Limp
     from dial.robot.snapshot import Snapshot
@@ -45,7 +45,7 @@ class LimpArgs(Args):
 
         return Limp(ctx, allotted, self.fingers, self.save)
 
-    def preview(self) -> Move:
+    def preview(self) -> PreviewMove:
         from dial.preview.moves import Stepped
 
         def make(m: Making) -> Limp:

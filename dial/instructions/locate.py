@@ -13,7 +13,7 @@ from dial.instructions.base import Args, Instruction, ParamSpec, Values
 from dial.instructions.types import Name, Names
 
 if TYPE_CHECKING:
-    from dial.preview.moves import Move
+    from dial.preview.moves import PreviewMove
     from dial.primitives.context import Context
     from dial.robot.snapshot import Snapshot
     from dial.scheduler.primitive import Sensor
@@ -40,7 +40,7 @@ class LocateArgs(Args):
 
         return Locate(ctx, self.location, self.also)
 
-    def preview(self) -> Move:
+    def preview(self) -> PreviewMove:
         from dial.preview.moves import Sensed
 
         return Sensed()

@@ -22,8 +22,7 @@ from dial.instructions.types import ARM, Choice, Integer, Name, Quantity
 from dial.scene.valii import Appro, Depart, Drive, Move, Statement
 
 if TYPE_CHECKING:
-    from dial.preview.moves import Making
-    from dial.preview.moves import Move as PreviewMove
+    from dial.preview.moves import Making, PreviewMove
     from dial.primitives.context import Context
     from dial.robot.snapshot import Snapshot
     from dial.scheduler.primitive import Allotment, Primitive

@@ -14,7 +14,7 @@ from dial.instructions.base import FINGER, Args, Instruction, ParamSpec, Values
 from dial.instructions.types import Choice, Name
 
 if TYPE_CHECKING:
-    from dial.preview.moves import Move
+    from dial.preview.moves import PreviewMove
     from dial.primitives.context import Context
     from dial.robot.snapshot import Snapshot
     from dial.scheduler.primitive import Sensor
@@ -52,7 +52,7 @@ class RecordContactArgs(Args):
 
         return RecordContact(ctx, self.finger, self.into, self.at, self.source)
 
-    def preview(self) -> Move:
+    def preview(self) -> PreviewMove:
         from dial.preview.moves import Sensed
 
         return Sensed(self.finger)

@@ -32,7 +32,7 @@ T_co = TypeVar("T_co", covariant=True)
 class Contact(NamedTuple):
     """A contact condition: it holds when finger ``finger``'s ``kind`` reading reaches
     ``threshold`` (m for tactile and position, N for force). See
-    :func:`dial.robot.contact.contact_reading`."""
+    :mod:`dial.robot.contact`."""
 
     kind: ContactKind
     finger: int

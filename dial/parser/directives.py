@@ -20,10 +20,10 @@ DEFAULT_RETRY = 3
 MAX_RETRY = 100
 
 RepeatSpec = tuple[Literal["count", "until", "while"], int, Condition | None]
-Report = Callable[[Span, str], None]
+OnError = Callable[[Span, str], None]  # reports a problem at a span
 
 
-def arity(error: Report, span: Span, name: str, words: list[Word], n: int, form: str) -> bool:
+def arity(error: OnError, span: Span, name: str, words: list[Word], n: int, form: str) -> bool:
     """Whether ``@name`` has ``n`` words; otherwise report ``form`` under the extra ones."""
     if len(words) == n:
         return True
@@ -32,7 +32,7 @@ def arity(error: Report, span: Span, name: str, words: list[Word], n: int, form:
     return False
 
 
-def condition(error: Report, word: Word) -> Condition | None:
+def condition(error: OnError, word: Word) -> Condition | None:
     m = _COND.match(word.text)
     if m is None:
         error(word.span, f"expected a condition EVENT or !EVENT, got '{word.text}'")
@@ -40,7 +40,7 @@ def condition(error: Report, word: Word) -> Condition | None:
     return Condition(m.group(2), m.group(1) == "!", word.span)
 
 
-def count(error: Report, word: Word, what: str, hi: int) -> int | None:
+def count(error: OnError, word: Word, what: str, hi: int) -> int | None:
     """A whole number from 1 to ``hi`` in ASCII digits."""
     text = word.text
     if (
@@ -53,7 +53,9 @@ def count(error: Report, word: Word, what: str, hi: int) -> int | None:
     return int(text)
 
 
-def repeat_spec(error: Report, span: Span, line_span: Span, words: list[Word]) -> RepeatSpec | None:
+def repeat_spec(
+    error: OnError, span: Span, line_span: Span, words: list[Word]
+) -> RepeatSpec | None:
     """``@repeat N`` or ``@repeat until|while COND [max N]``."""
     form = "N, or until/while COND [max N]"
     if not words:
@@ -81,7 +83,7 @@ def repeat_spec(error: Report, span: Span, line_span: Span, words: list[Word]) -
     return ("until" if head == "until" else "while", limit, cond)
 
 
-def one_condition(error: Report, span: Span, name: str, words: list[Word]) -> Condition | None:
+def one_condition(error: OnError, span: Span, name: str, words: list[Word]) -> Condition | None:
     """``@if COND`` or ``@on COND``."""
     form = f"one condition: @{name} EVENT or @{name} !EVENT"
     if not arity(error, span, name, words, 1, form):
@@ -89,7 +91,7 @@ def one_condition(error: Report, span: Span, name: str, words: list[Word]) -> Co
     return condition(error, words[0])
 
 
-def retry_max(error: Report, span: Span, words: list[Word]) -> int | None:
+def retry_max(error: OnError, span: Span, words: list[Word]) -> int | None:
     """``@retry [max N]``: the retry limit."""
     if not words:
         return DEFAULT_RETRY
@@ -99,7 +101,7 @@ def retry_max(error: Report, span: Span, words: list[Word]) -> int | None:
     return count(error, words[1], f"a retry limit from 1 to {MAX_RETRY}", MAX_RETRY)
 
 
-def abort_message(error: Report, span: Span, params: list[Param]) -> str | None:
+def abort_message(error: OnError, span: Span, params: list[Param]) -> str | None:
     """``@abort "MESSAGE"``: the message, one quoted string."""
     if len(params) != 1 or not params[0].quoted or not params[0].words:
         where = params[0].span.to(params[-1].span) if params else span
@@ -112,7 +114,7 @@ MAX_NAME_BYTES = 255  # one file or directory name, as file systems allow
 MAX_PATH_BYTES = 1024
 
 
-def file_path(error: Report, word: Word, what: str) -> bool:
+def file_path(error: OnError, word: Word, what: str) -> bool:
     """Whether ``word`` can name a file (if not, reported): no control character, and
     within the length that file systems allow."""
     text = word.text

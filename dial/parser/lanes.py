@@ -15,7 +15,6 @@ from typing import Any
 from dial.parser.script import Script, Step, TBlock, TCall, TIf, TRepeat
 
 Key = tuple[str, ...]  # (event,) in the script run, (script stem, event) in a called one
-Record = Mapping[str, Any]  # a log record (JSON object)
 
 
 @dataclass(frozen=True)
@@ -45,7 +44,8 @@ class LanePlan:
         }
 
     @classmethod
-    def from_record(cls, record: Record) -> LanePlan:
+    def from_record(cls, record: Mapping[str, Any]) -> LanePlan:
+        """The plan from its log record (read back as JSON)."""
         return cls(
             tuple(tuple(k) for k in record.get("order", [])),
             frozenset(tuple(k) for k in record.get("condition_only", [])),

@@ -61,7 +61,7 @@ class _Frame:
 class Structure:
     """The open directives, innermost last, and the statements each has collected."""
 
-    def __init__(self, error: args.Report, depth: int = 0) -> None:
+    def __init__(self, error: args.OnError, depth: int = 0) -> None:
         self.error = error
         self.base = depth  # the nesting level of the '@call' that runs this script
         self.stack: list[_Frame] = [_Frame("top", Span(1, 1, 2))]

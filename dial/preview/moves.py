@@ -73,7 +73,7 @@ class Stage(Protocol):
         ...
 
 
-class Move(Protocol):
+class PreviewMove(Protocol):
     """How the preview moves a run of an instruction."""
 
     def begin(self, stage: Stage) -> Outcome | None:

@@ -4,7 +4,7 @@ A block is walked as the runner walks it (tick by tick, runs started in line ord
 fixed-length run stepped every control period on its progress in tick time), with the
 set-points going straight to the pose: the arm and the fingers are where they are
 commanded. The pose is checked whenever it has moved a little (see :data:`ARM_STEP`), and
-at every period while a watched span is armed. Indeterminate runs are previewed at their
+at every period while a watched span is watched. Indeterminate runs are previewed at their
 start, at once (:mod:`dial.preview.motions`). Both branches of an ``@if`` are previewed from
 the same pose, and the walk goes on from the branch the previewed outcomes choose; every
 ``@on`` reaction is previewed from where its block ends (or where its monitor fired, from
@@ -33,7 +33,7 @@ from dial.preview.report import Counts, Problems
 from dial.preview.scene import Hit, Scene, State, finger_group
 from dial.robot.protocol import Course
 from dial.robot.snapshot import FloatArray, Snapshot
-from dial.scheduler.primitive import Now, Outcome, Primitive
+from dial.scheduler.primitive import Now, Outcome, Primitive, progress_after
 from dial.scheduler.types import RunInfo
 
 ARM_STEP = np.radians(0.25)  # rad of any arm joint between two checks of a moving pose
@@ -65,7 +65,7 @@ class Starting(NamedTuple):
 
 
 @dataclass(frozen=True)
-class Saved:
+class Bookmark:
     """Where a walk is: the scene, the latest outcomes, the contacts going on and whose."""
 
     state: State
@@ -160,10 +160,10 @@ class Walk:
                 self.latest[(script.path, cond.event)] = outcome
         return (self.latest.get((script.path, cond.event)) is Outcome.DONE) != cond.negated
 
-    def save(self) -> Saved:
-        return Saved(self.scene.save(), dict(self.latest), dict(self.ongoing))
+    def save(self) -> Bookmark:
+        return Bookmark(self.scene.save(), dict(self.latest), dict(self.ongoing))
 
-    def restore(self, saved: Saved) -> None:
+    def restore(self, saved: Bookmark) -> None:
         self.scene.restore(saved.state)
         self.latest, self.ongoing = dict(saved.latest), dict(saved.ongoing)
         self.seen = (self.scene.robot.arm_target.copy(), self.scene.robot.hand_target.copy())
@@ -177,17 +177,17 @@ class Walk:
         starts: dict[int, list[Run]] = defaultdict(list)
         for run in block.runs:
             starts[run.start].append(run)
-        armed: list[Watch] = []
+        watching: list[Watch] = []
         fired: TOn | None = None
         for k in range(1, block.length + 1):
-            armed += [w for w in block.watches if w.start == k]
+            watching += [w for w in block.watches if w.start == k]
             for run in starts[k]:
                 self.start(script, run)
-            fired = self.periods(script, block, k, armed)
+            fired = self.periods(script, block, k, watching)
             if fired is not None:
                 break
             self.finish(script, k)
-            armed = [w for w in armed if w.end != k]
+            watching = [w for w in watching if w.end != k]
         for a in self.active:
             if fired is not None:
                 self.latest[(a.place.path, a.run.event)] = Outcome.PREEMPTED
@@ -202,10 +202,10 @@ class Walk:
         self.panels.append(Panel(label, place, events, qpos, np.array(self.trace), problems, note))
         self.reactions(script, block, label, fired)
 
-    def periods(self, script: Script, block: TBlock, k: int, armed: list[Watch]) -> TOn | None:
+    def periods(self, script: Script, block: TBlock, k: int, watching: list[Watch]) -> TOn | None:
         """Step the runs executing in tick ``k``, period by period; a monitor that fires."""
         moving = [a for a in self.active if a.run.start <= k <= a.run.exec_end]
-        if not moving and not armed:
+        if not moving and not watching:
             self.clock += self.n
             return None
         snapshot = self.scene.robot.snapshot()
@@ -215,9 +215,9 @@ class Walk:
             for a, write in zip(moving, writes, strict=True):
                 a.progress = self.progress(a, self.clock)
                 write(i)
-            if armed:
+            if watching:
                 self.look()
-                fired = self.fires(script, block, armed)
+                fired = self.fires(script, block, watching)
                 if fired is not None:
                     return fired
             else:
@@ -225,26 +225,25 @@ class Walk:
         return None
 
     def progress(self, a: Active, clock: int) -> float:
-        """A run's progress in tick time at the end of period ``clock``, as the runner has it
-        (a one-tick run: a GOTO)."""
-        return 1.0 if a.span == self.n else min(1.0, (clock - a.start_clock) / a.span)
+        """A run's progress in tick time at the end of period ``clock``, as the runner has it."""
+        return progress_after(clock - a.start_clock, a.span, self.n)
 
     def course(self, a: Active, k: int, snapshot: Snapshot) -> Course:
         """A writer of the run's set-points in the ``i``-th period of tick ``k``: an open-loop
         run's course (what its step would write, bit for bit, worked out for the whole tick
         at once), else its step."""
         if a.prim.open_loop:
-            return a.prim.course([self.progress(a, self.clock + i) for i in range(1, self.n + 1)])
+            return a.prim.course(self.clock - a.start_clock + 1, self.n)
 
         def step(i: int) -> None:
             a.prim.step(snapshot, Now(0.0, k, a.progress, 0.0, False))
 
         return step
 
-    def fires(self, script: Script, block: TBlock, armed: list[Watch]) -> TOn | None:
+    def fires(self, script: Script, block: TBlock, watching: list[Watch]) -> TOn | None:
         """The first ``@on`` (in file order) whose watched contact condition holds now."""
         for on in block.reactions:
-            for watch in armed:
+            for watch in watching:
                 if watch.event != on.condition.event:
                     continue
                 touching = self.scene.touching({finger_group(watch.contact.finger)})

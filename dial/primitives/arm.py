@@ -10,10 +10,8 @@ otherwise solve one waypoint per control period).
 
 from __future__ import annotations
 
-import bisect
 import math
 from abc import abstractmethod
-from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cached_property
 
@@ -26,7 +24,7 @@ from dial.robot.protocol import Course
 from dial.robot.slots import still
 from dial.robot.snapshot import FloatArray, Snapshot
 from dial.scene.valii import Appro, Depart, Drive, Move, Statement
-from dial.scheduler.primitive import DONE, Allotment, Ended, Now, Outcome
+from dial.scheduler.primitive import DONE, Allotment, Ended, Now, Outcome, progress_after
 
 JOINT_SPEED = 1.0  # rad/s: nominal, only to share a run's time among its segments
 LINEAR_SPEED = 0.25  # m/s
@@ -186,7 +184,6 @@ class ArmMotion(RobotPrimitive):
         self._ends = np.array(self.bounds)  # for course: each segment's end and start
         self._starts = np.concatenate(([0.0], self._ends[:-1]))
         self._table: FloatArray | None = None  # course's set-points, made at its first call
-        self._progress: list[float] = []
         self.q = snapshot.arm_target.copy()
 
     def step(self, snapshot: Snapshot, now: Now) -> Ended | None:
@@ -203,24 +200,20 @@ class ArmMotion(RobotPrimitive):
 
     open_loop = True
 
-    def course(self, progress: Sequence[float]) -> Course:
-        """The set-points :meth:`step` would write at each progress. The runner's progress
-        at the k-th period of the run's tick time is min(1, k / span) (1 for a one-tick run):
-        the set-points of all of them are computed once, as one array, and a course is a
-        slice of it (checked: any other progress is computed as it comes)."""
+    def course(self, first: int, count: int) -> Course:
+        """The set-points :meth:`step` would write in these periods: those of all the run's
+        periods are computed once, as one array, and a course is a slice of it."""
         if not self.segments:
             return still
+        span, n = self.allotted.span, self.allotted.periods_per_tick
         if self._table is None:
-            n, span = self.allotted.periods_per_tick, self.allotted.span
-            self._progress = (
-                [1.0] * span if span == n else [min(1.0, k / span) for k in range(1, span + 1)]
-            )
-            self._table = self._rows(np.array(self._progress))
+            progress = [progress_after(k, span, n) for k in range(1, span + 1)]
+            self._table = self._rows(np.array(progress))
             self._table.flags.writeable = False
-        i, wanted = bisect.bisect_left(self._progress, progress[0]), list(progress)
-        if self._progress[i : i + len(wanted)] == wanted:
-            return self.slots.arm_course(self._table[i : i + len(wanted)])
-        return self.slots.arm_course(self._rows(np.array(wanted)))
+        if first >= 1 and first + count - 1 <= span:
+            return self.slots.arm_course(self._table[first - 1 : first - 1 + count])
+        beyond = [progress_after(k, span, n) for k in range(first, first + count)]
+        return self.slots.arm_course(self._rows(np.array(beyond)))
 
     def _rows(self, p: FloatArray) -> FloatArray:
         """(len(p), 6): :meth:`step`'s set-points at each progress in ``p``, bit for bit."""

@@ -2,7 +2,7 @@
 
 The motion runs at ``speed`` in simulated time (a safe approach speed, not tick
 time), so a guarded move that outlasts its ticks stretches its last tick. The
-guard is armed in the driver, which freezes the effector at the physics step
+guard is tested by the robot, which freezes the effector at the physics step
 where the contact is first sensed; the run then ends ``done`` with the contact,
 or ``missed`` when it reaches ``max`` travel without one. With ``press`` the
 effector is then set that much further on from where it stopped, so that a

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-
 import numpy as np
 
 from dial.geometry import smooth, smooth_array
@@ -11,7 +9,7 @@ from dial.primitives.context import Context, RobotPrimitive, done, missed
 from dial.robot.protocol import Course
 from dial.robot.slots import still
 from dial.robot.snapshot import FloatArray, Snapshot
-from dial.scheduler.primitive import Allotment, Ended, Now
+from dial.scheduler.primitive import Allotment, Ended, Now, progress_after
 
 
 def _bits(mask: int) -> list[int]:
@@ -40,7 +38,9 @@ class HandPose(RobotPrimitive):
 
     open_loop = True
 
-    def course(self, progress: Sequence[float]) -> Course:
+    def course(self, first: int, count: int) -> Course:
+        span, n = self.allotted.span, self.allotted.periods_per_tick
+        progress = [progress_after(k, span, n) for k in range(first, first + count)]
         s = smooth_array(np.asarray(progress, dtype=np.float64))
         return self.slots.joints_course(self.mask, self.q0 + (self.q1 - self.q0) * s[:, None])
 
@@ -117,7 +117,7 @@ class Limp(RobotPrimitive):
 
     open_loop = True  # the limp joints follow their measured angle in the driver
 
-    def course(self, progress: Sequence[float]) -> Course:
+    def course(self, first: int, count: int) -> Course:
         return still
 
     def finish(self, snapshot: Snapshot) -> Ended:

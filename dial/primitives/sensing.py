@@ -2,14 +2,14 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from dial.instructions.types import FINGERS, Contact
 from dial.primitives.context import Context, RobotPrimitive, done, missed
-from dial.robot.contact import contact_reading
+from dial.robot.contact import force_reading, position_reading, tactile_reading
 from dial.robot.snapshot import FloatArray, Snapshot
 from dial.scheduler.primitive import Allotment, Ended, Now, Outcome
 
@@ -28,21 +28,21 @@ class Get:
         return done(**self.read(snapshot))
 
 
-def contact_value(contact: Contact, snapshot: Snapshot, baseline: FloatArray | None) -> float:
-    """The reading a contact condition compares with its threshold (m or N); a dropped-out
-    sensor reads 0, as the driver's guards read it."""
+NO_BASELINE = (0.0,) * 16  # a force reading measured from zero: the differentials' value
+
+
+def contact_value(contact: Contact, snapshot: Snapshot, baseline: Sequence[float]) -> float:
+    """The reading (m or N) a contact condition compares with its threshold, from the
+    snapshot (:mod:`dial.robot.contact`); a force reading is the change from ``baseline``
+    (16 differentials). A dropped-out sensor reads 0, as the robot's guards read it."""
     kind, finger = contact.kind, contact.finger
     if (kind, finger) in snapshot.dropped:
         return 0.0
-    return contact_reading(
-        kind,
-        finger,
-        snapshot.tactile[finger],
-        snapshot.differentials,
-        snapshot.hand_target,
-        snapshot.hand_q,
-        baseline,
-    )
+    if kind == "tactile":
+        return tactile_reading(snapshot.tactile[finger])
+    if kind == "force":
+        return force_reading(snapshot.tensions.tolist(), baseline, finger)
+    return position_reading(snapshot.hand_target, snapshot.hand_q, finger)
 
 
 class ContactWait(RobotPrimitive):
@@ -54,7 +54,7 @@ class ContactWait(RobotPrimitive):
         self.contact = contact
 
     def start(self, snapshot: Snapshot) -> None:
-        self.baseline = snapshot.differentials.copy()
+        self.baseline = snapshot.differentials.tolist()
 
     def step(self, snapshot: Snapshot, now: Now) -> Ended | None:
         value = contact_value(self.contact, snapshot, self.baseline)
@@ -69,7 +69,7 @@ class ContactTest:
 
     def sense(self, snapshot: Snapshot) -> Ended:
         kind, finger, threshold = self.contact
-        value = contact_value(self.contact, snapshot, None)
+        value = contact_value(self.contact, snapshot, NO_BASELINE)
         if value >= threshold:
             return done(value=value)
         return missed(f"no {kind} contact on the {FINGERS[finger]}", value=value)

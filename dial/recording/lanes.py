@@ -28,7 +28,7 @@ from typing import Any
 from dial.parser.lanes import Key, LanePlan
 
 Lane = tuple[str, ...]  # entity path parts of a lane
-Record = Mapping[str, Any]
+LogRecord = Mapping[str, Any]  # a log record as read back (a JSON object)
 
 RUNNING, HELD, FIRED, DISTURBED = "running", "held", "fired", "disturbed"
 # state -> colour (RGB); outcomes follow DESIGN 2.5, the rest are this module's
@@ -49,7 +49,7 @@ DEFAULT_TICK = 0.1  # s; the marker width until the run's first tick has ended
 TESTS = ".tests"  # suffix of the lane that holds an event's markers when the event also runs
 
 
-def lane_key(record: Record) -> Key:
+def lane_key(record: LogRecord) -> Key:
     """The lane of a record's ``event``: a called script's events carry that script's name."""
     script = record.get("script")
     return (Path(str(script)).stem, str(record["event"])) if script else (str(record["event"]),)
@@ -114,7 +114,7 @@ class Lanes:
         """A marker's width in simulated time: one nominal tick."""
         return self._tick if self._tick is not None else DEFAULT_TICK
 
-    def feed(self, record: Record) -> list[Phase]:
+    def feed(self, record: LogRecord) -> list[Phase]:
         """The phases that ``record`` starts or ends now."""
         kind = record["kind"]
         if kind in ("start", "end", "condition", "monitor", "disturb", "tick"):
@@ -142,20 +142,20 @@ class Lanes:
         return out
 
     # -- the records ---------------------------------------------------------------------------
-    def _start(self, r: Record) -> list[Phase]:
+    def _start(self, r: LogRecord) -> list[Phase]:
         key = lane_key(r)
         self._started.add(key)
         t, k = float(r["t"]), int(r["tick"])
         self._runs[key] = _Run(key, t, k, int(r.get("line", 0)), str(r.get("script", "")))
         return self._begin(self.path(key), RUNNING, t, k)
 
-    def _end(self, r: Record) -> list[Phase]:
+    def _end(self, r: LogRecord) -> list[Phase]:
         run = self._runs.pop(lane_key(r), None)
         if run is not None:  # a condition-only event's instant run is drawn by its test
             self._ended.append(_Ended(run, str(r["outcome"]), float(r["t"]), int(r["tick"])))
         return []
 
-    def _tick_end(self, r: Record) -> list[Phase]:
+    def _tick_end(self, r: LogRecord) -> list[Phase]:
         k, t1 = int(r["tick"]), float(r["t1"])
         self._block[k] = int(r.get("block_tick", 0))
         if self._tick is None and not r.get("stretch"):
@@ -169,20 +169,20 @@ class Lanes:
             del self._held[lane]
         return out
 
-    def _condition(self, r: Record) -> list[Phase]:
+    def _condition(self, r: LogRecord) -> list[Phase]:
         text = str(r["condition"])
         key = lane_key({**r, "event": text.lstrip("!")})
         truth = bool(r["value"]) != text.startswith("!")
         return self._mark(key, "true" if truth else "false", float(r["t"]), int(r["tick"]))
 
-    def _monitor(self, r: Record) -> list[Phase]:
+    def _monitor(self, r: LogRecord) -> list[Phase]:
         t, k = float(r["t"]), int(r["tick"])
         for lane in self._held:  # the rest of the block is skipped: its holds end here
             self._clear[lane] = (t, k + 1)
         self._held = {}
         return self._mark(lane_key(r), FIRED, t, k)
 
-    def _disturb(self, r: Record) -> list[Phase]:
+    def _disturb(self, r: LogRecord) -> list[Phase]:
         lane = ("disturb", _safe(str(r["what"])))
         t, k = float(r["t"]), int(r["tick"])
         if r.get("phase") == "end":

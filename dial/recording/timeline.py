@@ -7,14 +7,13 @@ from __future__ import annotations
 
 import json
 import math
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
 from dial.errors import DialError
-from dial.recording.lanes import lane_key
+from dial.recording.lanes import LogRecord, lane_key
 
-Record = Mapping[str, Any]
 BAD_OUTCOMES = {"missed": "warn", "timeout": "error", "error": "error"}
 
 
@@ -93,7 +92,7 @@ def read_log(path: Path) -> list[dict[str, Any]]:
     return records
 
 
-def when(record: Record, tick: int) -> tuple[float, int]:
+def when(record: LogRecord, tick: int) -> tuple[float, int]:
     """A record's simulated time (s) and tick; ``tick`` (the latest seen) if it has none.
 
     (A ``summary`` holds the run's end time and the tick *length*, not a tick.)
@@ -104,13 +103,13 @@ def when(record: Record, tick: int) -> tuple[float, int]:
     return float(t), int(record.get("tick", tick))
 
 
-def qualified_event(record: Record) -> str:
+def qualified_event(record: LogRecord) -> str:
     """The event of a ``start`` or ``end`` record; a called script's events carry that
     script's name (``explore_surface.reach``), since event names repeat across scripts."""
     return ".".join(lane_key(record))
 
 
-def describe(record: Record) -> tuple[str, str] | None:
+def describe(record: LogRecord) -> tuple[str, str] | None:
     """A record as one line of text and a level (info, warn, error); None for bookkeeping."""
     kind = record["kind"]
     if kind == "scene":
@@ -168,7 +167,7 @@ def describe(record: Record) -> tuple[str, str] | None:
     return None
 
 
-def timeline(records: Iterable[Record]) -> str:
+def timeline(records: Iterable[LogRecord]) -> str:
     """The run's timeline: one line per event start, end, contact, condition and message."""
     lines = [f"{'tick':>5}  {'t (s)':>8}  what"]
     tick = 0

@@ -1,36 +1,42 @@
-"""The readings that guards (in the driver) and contact waits (primitives) compare with
-their thresholds: one definition, so that a guard and a wait mean the same contact."""
+"""The contact readings, defined once: a contact wait reads them from its snapshot
+(:func:`dial.primitives.sensing.contact_value`), and a robot's guards and monitors read them
+after every physics step (:class:`dial.backend.guards.Readings`), so that a guard, a monitor
+and a wait mean the same contact. ``tests/engine/test_contact_reading.py`` checks that both
+agree on random states of every scene.
+
+Each is written in the form that the per-step test can afford, as it runs thousands of
+times a run: Python floats where there are few values, and the deepest taxel through
+``argmax``, which costs a quarter of ``max`` just after a physics step.
+"""
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
-from numpy.typing import ArrayLike
 
 from dial.robot.snapshot import FloatArray
 
 POSITION_LEVER = 0.1  # m: joint error (rad) to fingertip displacement, about a finger length
 
 
-def contact_reading(
-    kind: str,
-    finger: int,
-    depths: ArrayLike,
-    differentials: FloatArray,
-    target: FloatArray,
-    q: FloatArray,
-    baseline: FloatArray | None = None,
-) -> float:
-    """The reading of contact ``kind`` (tactile, force or position) on ``finger``.
+def tactile_reading(depths: FloatArray) -> float:
+    """The deepest taxel of a fingertip's array (m); ``depths``: its taxel depths, any shape."""
+    return float(depths.item(depths.argmax()))
 
-    ``depths``: that finger's taxel depths (m, any shape); ``differentials``, ``target`` and
-    ``q``: (16,) tendon differentials (N) and joint set-points and angles (rad), mask order;
-    ``baseline``: differentials to measure a change from (force), or None for their value.
-    Returns m (tactile: deepest taxel; position: set-point error times the lever) or N.
-    """
+
+def force_reading(tensions: Sequence[float], baseline: Sequence[float], finger: int) -> float:
+    """The largest change (N) of the finger's four tendon differentials (flexor minus extensor
+    tension) from ``baseline`` (the 16 differentials to measure from, mask order; zeros for
+    their value). ``tensions``: the 32 tendon tensions, flexor then extensor of each joint."""
+    return max(
+        abs(tensions[2 * k] - tensions[2 * k + 1] - baseline[k])
+        for k in range(4 * finger, 4 * finger + 4)
+    )
+
+
+def position_reading(target: FloatArray, q: FloatArray, finger: int) -> float:
+    """The finger's joint error (its set-points ``target`` minus its angles ``q``, (16,) rad,
+    mask order) times the lever: about its fingertip's displacement (m)."""
     joints = slice(4 * finger, 4 * finger + 4)
-    if kind == "tactile":
-        return float(np.max(depths))
-    if kind == "force":
-        base = baseline[joints] if baseline is not None else 0.0
-        return float(np.abs(differentials[joints] - base).max())
     return float(np.linalg.norm(target[joints] - q[joints])) * POSITION_LEVER

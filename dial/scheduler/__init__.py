@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:
     from dial.scheduler.log import EventLog, LogError
     from dial.scheduler.primitive import DONE, Allotment, Ended, Now, Outcome, Primitive, Sensor
-    from dial.scheduler.runner import Runner, RunSummary
+    from dial.scheduler.runner import Runner, Tally
     from dial.scheduler.signals import EXIT_STATUS, StopRequest, catch_stop_signals
     from dial.scheduler.types import (
         Interrupted,
@@ -26,7 +26,7 @@ _HOMES = {
     "dial.scheduler.primitive": (
         *("DONE", "Allotment", "Ended", "Now", "Outcome", "Primitive", "Sensor"),
     ),
-    "dial.scheduler.runner": ("Runner", "RunSummary"),
+    "dial.scheduler.runner": ("Runner", "Tally"),
     "dial.scheduler.signals": ("EXIT_STATUS", "StopRequest", "catch_stop_signals"),
     "dial.scheduler.types": (
         *("Interrupted", "PrimitiveFactory", "RunAborted", "RunInfo", "periods_per_tick"),
@@ -48,10 +48,10 @@ __all__ = [
     "PrimitiveFactory",
     "RunAborted",
     "RunInfo",
-    "RunSummary",
     "Runner",
     "Sensor",
     "StopRequest",
+    "Tally",
     "catch_stop_signals",
     "periods_per_tick",
 ]

@@ -26,7 +26,7 @@ from dial.parser.script import Run, Script
 from dial.robot.protocol import Clocked, Course, Fired, Report
 from dial.scheduler.active import ActiveRun
 from dial.scheduler.position import Hooks, Resume
-from dial.scheduler.primitive import Ended, Now, Outcome
+from dial.scheduler.primitive import Ended, Now, Outcome, progress_after
 from dial.scheduler.records import Records
 from dial.scheduler.signals import StopRequest
 from dial.scheduler.types import Interrupted, RunAborted, S
@@ -78,7 +78,7 @@ class Periods(Generic[S]):
 
     def progress_of(self, a: ActiveRun[S]) -> float:
         """A run's progress in tick time now (0 to 1)."""
-        return 1.0 if a.span == self.n else min(1.0, (self.clock - a.start_clock) / a.span)
+        return progress_after(self.clock - a.start_clock, a.span, self.n)
 
     def restore(self, resume: Resume) -> None:
         """Take up the clocks, outcomes and counts of a run saved at a block boundary."""
@@ -115,15 +115,7 @@ class Periods(Generic[S]):
         runs = [a for a in self.active if a.ended is None]
         if not all(a.prim.open_loop for a in runs):
             return None
-        n, clock = self.n, self.clock
-        return [
-            a.prim.course(
-                [1.0] * most
-                if a.span == n
-                else [min(1.0, (clock + j - a.start_clock) / a.span) for j in range(1, most + 1)]
-            )
-            for a in runs
-        ]
+        return [a.prim.course(self.clock - a.start_clock + 1, most) for a in runs]
 
     def _coast(self, writes: list[Course], most: int) -> tuple[Fired, ...]:
         """Periods as :meth:`_step` takes them, with the open-loop runs' set-points written
@@ -184,8 +176,7 @@ class Periods(Generic[S]):
             if a.ended is not None:
                 continue
             elapsed = (periods - a.start_period) * self.period
-            # A one-tick run is a GOTO MOVE: the set-point jumps at once.
-            progress = 1.0 if a.span == n else min(1.0, (clock - a.start_clock) / a.span)
+            progress = progress_after(clock - a.start_clock, a.span, n)
             try:
                 ended = a.prim.step(snapshot, Now(t_end, tick, progress, elapsed, stretched))
             except DialError as e:

@@ -1,6 +1,6 @@
 """Where a run is in its timeline, and the seam where a debugger or a state saver joins it.
 
-A :data:`Path` names a step exactly, also inside ``@repeat``, ``@if``, ``@call`` and an
+A :data:`TimelinePath` names a step exactly, also inside ``@repeat``, ``@if``, ``@call`` and an
 ``@on`` reaction: one :class:`Frame` per level of the walk. Saving a run at a block
 boundary keeps its path; resuming walks straight back down it (DESIGN 6.1).
 """
@@ -31,14 +31,14 @@ class Frame(NamedTuple):
     reaction: int = -1
 
 
-Path = tuple[Frame, ...]
+TimelinePath = tuple[Frame, ...]
 
 
 @dataclass(frozen=True)
 class Resume:
     """What the runner needs to go on from a saved block boundary."""
 
-    path: Path
+    path: TimelinePath
     blocks: int  # blocks started before the saved one
     periods: int
     clock: int
@@ -52,7 +52,9 @@ class Hooks(Protocol):
 
     each_period: bool  # call after_period after every control period (a debugger stepping)
 
-    async def before_block(self, number: int, path: Path, script: Script, block: TBlock) -> None:
+    async def before_block(
+        self, number: int, path: TimelinePath, script: Script, block: TBlock
+    ) -> None:
         """Before the ``number``-th block the run starts (1-based, repeats and retries too)."""
 
     async def before_tick(self, tick: int, script: Script, starting: Sequence[Run]) -> None:

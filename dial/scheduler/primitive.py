@@ -9,7 +9,7 @@ scripts or of MuJoCo.
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from enum import StrEnum
 from typing import Generic, NamedTuple, Protocol, TypeVar
@@ -46,6 +46,17 @@ class Ended:
 
 
 DONE = Ended(Outcome.DONE)
+
+
+def progress_after(k: int, span: int, n: int) -> float:
+    """A run's progress in tick time after ``k`` of its tick-time periods: ``k / span``, at
+    most 1, for a run of ``span`` executing periods; 1 from the first period of a one-tick
+    run (``span == n``, the periods of a tick), a GOTO MOVE whose set-point jumps at once.
+
+    The one definition of progress: the runner's steps, its courses (open-loop runs taking
+    the coming periods at once) and the preview's walk all compute it here.
+    """
+    return 1.0 if span == n else min(1.0, k / span)
 
 
 class Now(NamedTuple):
@@ -89,10 +100,12 @@ class Primitive(ABC, Generic[S_contra]):
     #: are a function of its progress alone, so the runner may take them in one go (coast).
     open_loop: bool = False
 
-    def course(self, progress: Sequence[float]) -> Course:
-        """An open-loop run's writer of the set-points that :meth:`step` would write in the
-        coming periods, at these progress values (one per period, in order): calling it with
-        ``k`` writes the ``k``-th period's and leaves the run as if stepped through it."""
+    def course(self, first: int, count: int) -> Course:
+        """An open-loop run's writer of the set-points that :meth:`step` would write in its
+        tick-time periods ``first`` to ``first + count - 1`` (at :func:`progress_after` each):
+        calling it with ``j`` writes period ``first + j``'s and leaves the run as if stepped
+        through it. The set-points are worked out at once, as arrays: that is what makes
+        coasting cheaper than stepping (see docs/architecture.md)."""
         raise NotImplementedError(f"{type(self).__name__} is not open-loop")
 
     def stop(self) -> None:

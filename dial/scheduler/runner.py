@@ -29,10 +29,10 @@ from dial.parser.script import (
 )
 from dial.robot.protocol import Clocked
 from dial.scheduler.log import EventLog
-from dial.scheduler.position import Frame, Hooks, Path, Resume
+from dial.scheduler.position import Frame, Hooks, Resume, TimelinePath
 from dial.scheduler.primitive import Outcome
 from dial.scheduler.records import Records
-from dial.scheduler.signals import StopRequest, catch_stop_signals
+from dial.scheduler.signals import StopRequest
 from dial.scheduler.ticks import Observe, Progress, TickLoop
 from dial.scheduler.types import Interrupted, PrimitiveFactory, RunAborted, S, periods_per_tick
 
@@ -40,8 +40,9 @@ Ending = TResume | TRetry | TAbort  # how a reaction ends, once one of these is 
 
 
 @dataclass(frozen=True)
-class RunSummary:
-    """What a finished, aborted or interrupted run reports.
+class Tally:
+    """The runner's tally of a script's run, finished, aborted or interrupted: its ticks,
+    periods and simulated time, and how many of its events' runs ended each way.
 
     ``error`` is why the script stopped early (None when it ran to its end);
     ``interrupted`` names the signal that stopped it (``SIGINT``/``SIGTERM``), if any.
@@ -84,7 +85,7 @@ class Runner(Generic[S]):
         self._path: list[Frame] = []  # where the walk is now
         self.loop: TickLoop[S] | None = None
 
-    async def run(self, script: Script, resume: Resume | None = None) -> RunSummary:
+    async def run(self, script: Script, resume: Resume | None = None) -> Tally:
         """Run the script to its end, its abort or a stop signal; every effector then holds.
 
         ``resume``: go on from a saved block boundary instead of the first block.
@@ -103,11 +104,10 @@ class Runner(Generic[S]):
         if pace is not None:
             loop.t0 = trio.current_time()
         try:
-            with catch_stop_signals(self.stop):
-                if self.stop.signal is not None:  # it came while the scene was being prepared
-                    raise Interrupted(self.stop.signal)
-                path = resume.path if resume is not None else ()
-                await self._walk(loop, script, script.timeline, path)
+            if self.stop.signal is not None:  # it came while the scene was being prepared
+                raise Interrupted(self.stop.signal)
+            path = resume.path if resume is not None else ()
+            await self._walk(loop, script, script.timeline, path)
         except RunAborted as e:
             error = e
             records.error(e.event, e.tick, loop.sim_time, str(e))
@@ -119,7 +119,7 @@ class Runner(Generic[S]):
                 loop.stop_runs()  # stop always runs, in order, on every path
             finally:
                 self.robot.hold_all()  # on abort, interrupt or bug: the arm never drops
-        return RunSummary(
+        return Tally(
             error is None and interrupted is None,
             error,
             loop.sim_time,
@@ -132,7 +132,7 @@ class Runner(Generic[S]):
 
     # -- the timeline walk ------------------------------------------------------------------------
     async def _walk(
-        self, loop: TickLoop[S], script: Script, steps: tuple[Step, ...], resume: Path = ()
+        self, loop: TickLoop[S], script: Script, steps: tuple[Step, ...], resume: TimelinePath = ()
     ) -> Ending | None:
         """Run ``steps`` in order (from ``resume`` on, if given); return the reaction ending
         that stopped them, if any."""
@@ -149,7 +149,7 @@ class Runner(Generic[S]):
         return None
 
     async def _step(
-        self, loop: TickLoop[S], script: Script, step: Step, at: Frame, inner: Path
+        self, loop: TickLoop[S], script: Script, step: Step, at: Frame, inner: TimelinePath
     ) -> Ending | None:
         if isinstance(step, TBlock):
             await self._block(loop, script, step, at, inner)
@@ -171,7 +171,7 @@ class Runner(Generic[S]):
         return None
 
     async def _block(
-        self, loop: TickLoop[S], script: Script, block: TBlock, at: Frame, inner: Path
+        self, loop: TickLoop[S], script: Script, block: TBlock, at: Frame, inner: TimelinePath
     ) -> None:
         """A block, and its reactions each time a monitor preempts it (DESIGN 2.7)."""
         retries = at.detail
@@ -216,7 +216,7 @@ class Runner(Generic[S]):
                 )
 
     async def _repeat(
-        self, loop: TickLoop[S], script: Script, step: TRepeat, at: Frame, inner: Path
+        self, loop: TickLoop[S], script: Script, step: TRepeat, at: Frame, inner: TimelinePath
     ) -> Ending | None:
         for k in range(at.detail, step.count):
             self._path[-1] = Frame(at.step, k)

@@ -6,6 +6,11 @@ Why not trio's default KeyboardInterrupt: it is raised wherever the main thread 
 e.g. inside a native IK solve, which can turn it into an unrelated error. Here a signal
 only sets a flag; the run stops at the next period boundary, every effector holds, and
 the log is written to its end. A second signal while the run cleans up changes nothing.
+
+:func:`catch_stop_signals` is the one place that installs the handlers. Whoever starts a
+run calls it, and only the outermost call installs them: the command line for the whole of
+``dial run`` (its check, the run, its report), else :func:`dial.engine.run` for the run;
+an inner call shares the outer one's request. The runner only polls the request it is given.
 """
 
 from __future__ import annotations
@@ -32,9 +37,18 @@ class StopRequest:
             self.signal = name
 
 
+_owner: StopRequest | None = None  # the request the installed handlers feed, if any
+
+
 @contextmanager
-def catch_stop_signals(stop: StopRequest) -> Iterator[StopRequest]:
-    """Turn SIGINT and SIGTERM into ``stop`` for the duration (main thread only)."""
+def catch_stop_signals() -> Iterator[StopRequest]:
+    """Turn SIGINT and SIGTERM into a stop request for the duration (main thread only); inside
+    another call, share its request."""
+    global _owner
+    if _owner is not None:
+        yield _owner
+        return
+    stop = StopRequest()
     if threading.current_thread() is not threading.main_thread():
         yield stop  # worker threads cannot own signals; their process's owner handles them
         return
@@ -43,8 +57,10 @@ def catch_stop_signals(stop: StopRequest) -> Iterator[StopRequest]:
         stop.request(_NAMES.get(signal.Signals(signum), "a signal"))
 
     previous = {s: signal.signal(s, handler) for s in _NAMES}
+    _owner = stop
     try:
         yield stop
     finally:
+        _owner = None
         for s, old in previous.items():
             signal.signal(s, old)

@@ -2,8 +2,8 @@
 
 A block's runs start in line order at their tick; every tick's control periods go through
 :class:`~dial.scheduler.periods.Periods`; a fixed-length run ends with its last executing
-tick, and an indeterminate one still going stretches it. A watched span arms its monitors
-in the robot; when one fires, the block is preempted and its ``@on`` reaction runs next.
+tick, and an indeterminate one still going stretches it. The robot watches the monitors of
+a watched span; when one fires, the block is preempted and its ``@on`` reaction runs next.
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ from typing import NamedTuple
 from dial.errors import DialError
 from dial.parser.script import Run, Script, TBlock, TOn, Watch
 from dial.robot.protocol import Clocked, Course, Fired, Monitor
-from dial.scheduler.active import ActiveRun, RunPlan
+from dial.scheduler.active import ActiveRun
 from dial.scheduler.periods import ABORT_ON, Observe, Periods, Progress
 from dial.scheduler.primitive import Ended, Outcome, Sensor
 from dial.scheduler.records import Records
@@ -58,7 +58,7 @@ class TickLoop(Periods[S]):
         super().__init__(robot, n, records, stop, observe, pace)
         self.factory, self.progress = factory, progress
         self._plans: dict[int, _Plan] = {}
-        self._runs: dict[tuple[str, int], RunPlan] = {}
+        self._runs: dict[tuple[str, int], RunInfo] = {}
 
     # -- one block ------------------------------------------------------------------------------
     async def block(self, script: Script, block: TBlock) -> Preempted | None:
@@ -164,27 +164,27 @@ class TickLoop(Periods[S]):
         self.records.tick(self.tick, k, t0, self.sim_time, stretch, preempted)
 
     # -- starting and sensing runs ------------------------------------------------------------
-    def _run_plan(self, script: Script, run: Run) -> RunPlan:
+    def _info(self, script: Script, run: Run) -> RunInfo:
+        """The run's place, worked out once per run of the timeline."""
         key = (script.path, id(run))
-        plan = self._runs.get(key)
-        if plan is None:
+        info = self._runs.get(key)
+        if info is None:
             event = script.events[run.event]
-            info = RunInfo(event, run, script.path, self.n, self.period)
-            plan = self._runs[key] = RunPlan.of(info)
-        return plan
+            info = self._runs[key] = RunInfo(event, run, script.path, self.n, self.period)
+        return info
 
     def _start(self, script: Script, run: Run) -> None:
         """Start a run in line order; a sensing run happens at once."""
-        plan = self._run_plan(script, run)
+        info = self._info(script, run)
         self.counts["runs"] += 1
-        if plan.info.event.instruction.length == "zero":
-            sensor = self.factory.sensor(plan.info)
+        if info.event.instruction.length == "zero":
+            sensor = self.factory.sensor(info)
             self.records.start(script.path, run, self.tick, self.sim_time)
             self._sense(script, run, sensor)
             return
-        prim = self.factory.primitive(plan.info)
+        prim = self.factory.primitive(info)
         self.records.start(script.path, run, self.tick, self.sim_time)
-        active = ActiveRun(script, plan, prim, self.tick, self.periods, self.clock)
+        active = ActiveRun(script, info, prim, self.tick, self.periods, self.clock)
         self.active.append(active)  # from here on, its stop runs whatever happens
         try:
             active.prim.start(self._snapshot())

@@ -45,6 +45,16 @@ class RunInfo:
         return (self.run.exec_end - self.run.start + 1) * self.periods_per_tick
 
     @property
+    def fixed(self) -> bool:
+        """A fixed-length run: it ends with its last executing tick."""
+        return self.event.instruction.length == "fixed"
+
+    @property
+    def timeout(self) -> float | None:
+        """Simulated s after which the run ends ``timeout``: only indeterminate runs time out."""
+        return None if self.fixed else self.event.args.time_limit()
+
+    @property
     def allotment(self) -> Allotment:
         """What the run's primitive is allotted: its effectors and its span."""
         return Allotment(self.event.effectors, self.span, self.periods_per_tick, self.period)

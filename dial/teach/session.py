@@ -42,7 +42,7 @@ from dial.teach.commands import (
 from dial.teach.frames import matrix_rpy, relative
 from dial.teach.sim import Collision, Pose3, Sim, State
 from dial.teach.target import Target, check_name
-from dial.teach.worldfile import Saved, location_entry, pose_entry, render, write_world
+from dial.teach.worldfile import Taught, location_entry, pose_entry, render, write_world
 
 
 class TeachError(DialError):
@@ -55,7 +55,7 @@ class Step:
 
     line: str
     state: State
-    saved: tuple[Saved, ...]
+    saved: tuple[Taught, ...]
     world: World
     goal: Pose3
 
@@ -71,8 +71,8 @@ class Session:
 
     def __init__(self, world: World, target: Target, sim: Sim) -> None:
         self.world, self.target, self.sim = world, target, sim
-        self.saved: tuple[Saved, ...] = ()
-        self.written: tuple[Saved, ...] = ()  # what the target file holds of ours
+        self.saved: tuple[Taught, ...] = ()
+        self.written: tuple[Taught, ...] = ()  # what the target file holds of ours
         self.history: list[Step] = []
         # The tool pose the arm was last sent to. Jogs add to it, and `save location` saves
         # it, so that steps do not drift by the IK's tolerance (0.5 mm) one after another.
@@ -80,7 +80,7 @@ class Session:
 
     # -- state ----------------------------------------------------------------------------------
     @property
-    def unsaved(self) -> tuple[Saved, ...]:
+    def unsaved(self) -> tuple[Taught, ...]:
         """Names saved in the session that the file does not hold (as saved)."""
         return tuple(e for e in self.saved if e not in self.written)
 
@@ -235,7 +235,7 @@ class Session:
         return self._hand_goal({b: a for b, a in pose.angles.items() if mask >> b & 1}, mask)
 
     # -- saving ---------------------------------------------------------------------------------
-    def _save(self, entry: Saved, note: str, world: World) -> str:
+    def _save(self, entry: Taught, note: str, world: World) -> str:
         key = (entry.table, entry.name)
         self.saved = (*(e for e in self.saved if (e.table, e.name) != key), entry)
         self._set_world(world)
@@ -288,7 +288,7 @@ class Session:
         return f"wrote {names} to {path}{kept}"
 
 
-def _count(entries: tuple[Saved, ...]) -> str:
+def _count(entries: tuple[Taught, ...]) -> str:
     names = ", ".join(e.name for e in entries)
     return f"{len(entries)} saved name{'s' if len(entries) != 1 else ''} ({names})"
 

@@ -20,7 +20,7 @@ from typing import Any
 from dial.errors import DialError
 from dial.scene.resolve import resolve_scene, worlds_dir
 from dial.scene.world import World, load_world
-from dial.teach.worldfile import Saved, TableName, entry_names, new_file_text
+from dial.teach.worldfile import TableName, Taught, entry_names, new_file_text
 
 TABLES: tuple[TableName, ...] = ("poses", "locations")
 
@@ -102,7 +102,7 @@ def _walk(path: Path, target: Path, out: dict[tuple[str, str], str], seen: set[P
 
 
 def check_name(
-    target: Target, saved: tuple[Saved, ...], table: TableName, name: str, replace: bool
+    target: Target, saved: tuple[Taught, ...], table: TableName, name: str, replace: bool
 ) -> str:
     """Raise :class:`NameClash` if ``name`` may not be saved; else a note on what it replaces."""
     kind = table.removesuffix("s")

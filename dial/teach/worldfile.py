@@ -38,7 +38,7 @@ class WriteError(DialError):
 
 
 @dataclass(frozen=True)
-class Saved:
+class Taught:
     """One taught name as TOML text: ``items`` are (key, value) pairs in writing order.
 
     A location is one inline table (``{ object = "pitcher", pos = [...], rpy = [...] }``); a
@@ -78,7 +78,7 @@ def location_entry(
     pos: Iterable[float],
     rpy_deg: Iterable[float],
     world_axes: bool,
-) -> tuple[Location, Saved]:
+) -> tuple[Location, Taught]:
     """A location rounded to what is written (0.1 mm, 0.1 deg), and its TOML entry."""
     p = tuple(round(v, POS_DIGITS) for v in pos)
     r = tuple(half_turn(round(v, ANGLE_DIGITS)) for v in rpy_deg)
@@ -88,10 +88,10 @@ def location_entry(
         items.append(("axes", '"world"'))
     rad = (math.radians(r[0]), math.radians(r[1]), math.radians(r[2]))
     location = Location(name, body, (p[0], p[1], p[2]), rad, "world" if world_axes else "object")
-    return location, Saved("locations", name, tuple(items))
+    return location, Taught("locations", name, tuple(items))
 
 
-def pose_entry(name: str, angles_deg: dict[int, float]) -> tuple[HandPose, Saved]:
+def pose_entry(name: str, angles_deg: dict[int, float]) -> tuple[HandPose, Taught]:
     """A pose of the joints in ``angles_deg`` (mask bit -> deg), rounded to 0.1 deg."""
     rounded = {bit: round(a, ANGLE_DIGITS) for bit, a in sorted(angles_deg.items())}
     items = []
@@ -102,7 +102,7 @@ def pose_entry(name: str, angles_deg: dict[int, float]) -> tuple[HandPose, Saved
         elif joints:
             items.append((finger, _inline((JOINTS[j], number(a, ANGLE_DIGITS)) for j, a in joints)))
     pose = HandPose(name, {bit: math.radians(a) for bit, a in rounded.items()})
-    return pose, Saved("poses", name, tuple(items))
+    return pose, Taught("poses", name, tuple(items))
 
 
 def new_file_text(extends: str, scene: str, into: str) -> str:
@@ -127,7 +127,7 @@ def _blank_line(doc: tomlkit.TOMLDocument) -> None:
         doc.add(tomlkit.nl())
 
 
-def _put_location(doc: tomlkit.TOMLDocument, entry: Saved) -> None:
+def _put_location(doc: tomlkit.TOMLDocument, entry: Taught) -> None:
     table = doc.get("locations")
     if table is None:
         table = tomlkit.table()
@@ -136,7 +136,7 @@ def _put_location(doc: tomlkit.TOMLDocument, entry: Saved) -> None:
     table[entry.name] = _value(_inline(entry.items))
 
 
-def _put_pose(doc: tomlkit.TOMLDocument, entry: Saved) -> None:
+def _put_pose(doc: tomlkit.TOMLDocument, entry: Taught) -> None:
     poses = doc.get("poses")
     if poses is None:
         poses = tomlkit.table(is_super_table=True)
@@ -156,7 +156,7 @@ def _put_pose(doc: tomlkit.TOMLDocument, entry: Saved) -> None:
     poses[entry.name] = table
 
 
-def render(text: str, entries: Iterable[Saved]) -> str:
+def render(text: str, entries: Iterable[Taught]) -> str:
     """``text`` (a world file) with ``entries`` put into it."""
     doc = tomlkit.parse(text)
     for entry in entries:

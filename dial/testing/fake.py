@@ -23,8 +23,8 @@ from dial.parser.check import check_text
 from dial.parser.script import Script
 from dial.robot.protocol import Course, Fired, Monitor, Report, StopFlag, advance_through
 from dial.scheduler.log import EventLog, Record
-from dial.scheduler.primitive import Ended, Now, Outcome, Primitive, Sensor
-from dial.scheduler.runner import Runner, RunSummary
+from dial.scheduler.primitive import Ended, Now, Outcome, Primitive, Sensor, progress_after
+from dial.scheduler.runner import Runner, Tally
 from dial.scheduler.types import RunInfo
 
 
@@ -124,6 +124,7 @@ class _Motion(Primitive[FakeSnapshot]):
         self.commands, self.effectors = robot.commands, info.event.effectors
         self.stops = robot.stops
         self.name = info.event.name
+        self.span, self.n = info.span, info.periods_per_tick
 
     def step(self, snapshot: FakeSnapshot, now: Now) -> Ended | None:
         for effector in self.effectors:
@@ -132,7 +133,10 @@ class _Motion(Primitive[FakeSnapshot]):
 
     open_loop = True
 
-    def course(self, progress: Sequence[float]) -> Course:
+    def course(self, first: int, count: int) -> Course:
+        span, n = self.span, self.n
+        progress = [progress_after(k, span, n) for k in range(first, first + count)]
+
         def write(k: int) -> None:
             for effector in self.effectors:
                 self.commands[effector] = progress[k]
@@ -193,7 +197,7 @@ class FakeFactory:
 
 @dataclass
 class FakeResult:
-    summary: RunSummary
+    summary: Tally
     log: EventLog
     robot: FakeRobot
     trio_time: float

@@ -23,7 +23,7 @@ from dial.parser.check import load
 from dial.parser.script import Script
 from dial.robot.protocol import Report
 from dial.scheduler.log import EventLog
-from dial.scheduler.runner import Runner, RunSummary
+from dial.scheduler.runner import Runner, Tally
 from dial.testing.fake import FakeFactory, FakeRobot
 from dial.tune.grid import Trial
 from dial.tune.trial import RunReport
@@ -56,7 +56,7 @@ class LimitedRobot(FakeRobot):
 
 @dataclass(frozen=True)
 class LimitedResult:
-    summary: RunSummary
+    summary: Tally
     robot: LimitedRobot
     reached_goal: bool
 

@@ -9,7 +9,7 @@ the table, the verdict and the JSON object.
 """
 
 from dial.tune.command import TuneOptions, tune
-from dial.tune.executor import WORKER_DIED, Executor, ProcessExecutor, Progress, SerialExecutor
+from dial.tune.executor import WORKER_DIED, Executor, ItemsDone, ProcessExecutor, SerialExecutor
 from dial.tune.grid import Trial, parse_ticks, plan, trial_seed
 from dial.tune.ray_executor import RayExecutor
 from dial.tune.report import TickRow, fastest_reliable, render_table, summarise, to_json, verdict
@@ -27,8 +27,8 @@ __all__ = [
     "WORKER_DIED",
     "Backend",
     "Executor",
+    "ItemsDone",
     "ProcessExecutor",
-    "Progress",
     "RayExecutor",
     "RunReport",
     "SerialExecutor",

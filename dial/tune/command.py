@@ -17,7 +17,7 @@ from dial.parser.check import load
 from dial.resources import resolve_script
 from dial.scene import load_scene_names
 from dial.scene.of_script import check_pushes, script_world
-from dial.tune.executor import Executor, Progress
+from dial.tune.executor import Executor, ItemsDone
 from dial.tune.grid import Trial, plan
 from dial.tune.report import TickRow, fastest_reliable, render_table, summarise, to_json, verdict
 from dial.tune.trial import Backend, engine_backend, sweep
@@ -37,7 +37,7 @@ class TuneOptions:
 
 
 @contextmanager
-def _progress_bar(total: int, stream: TextIO) -> Iterator[Progress | None]:
+def _progress_bar(total: int, stream: TextIO) -> Iterator[ItemsDone | None]:
     if not stream.isatty():
         yield None
         return

@@ -22,7 +22,7 @@ from typing import Protocol, TypeVar
 T = TypeVar("T")
 R = TypeVar("R")
 
-Progress = Callable[[int], None]  # called with the number of items done so far
+ItemsDone = Callable[[int], None]  # called with the number of items done so far
 Initializer = Callable[[], None]  # run once in each worker process before its first item
 
 # The reason given for an item that killed its worker every time it ran, whatever the
@@ -36,7 +36,7 @@ class Executor(Protocol):
         fn: Callable[[T], R],
         items: Sequence[T],
         lost: Callable[[T, str], R],
-        progress: Progress | None = None,
+        progress: ItemsDone | None = None,
     ) -> list[R]:
         """``[fn(item) for item in items]``, in item order, however they are run.
 
@@ -54,7 +54,7 @@ class SerialExecutor:
         fn: Callable[[T], R],
         items: Sequence[T],
         lost: Callable[[T, str], R],
-        progress: Progress | None = None,
+        progress: ItemsDone | None = None,
     ) -> list[R]:
         results = []
         for item in items:
@@ -125,7 +125,7 @@ class ProcessExecutor:
         fn: Callable[[T], R],
         items: Sequence[T],
         lost: Callable[[T, str], R],
-        progress: Progress | None = None,
+        progress: ItemsDone | None = None,
     ) -> list[R]:
         started = self._context().RawArray(ctypes.c_bool, max(len(items), 1))
         results: dict[int, R] = {}
@@ -154,7 +154,7 @@ class ProcessExecutor:
         workers: int,
         started: ctypes.Array[ctypes.c_bool],
         results: dict[int, R],
-        progress: Progress | None,
+        progress: ItemsDone | None,
     ) -> str | None:
         """Run ``todo`` in a fresh pool of ``workers``; return why the pool broke, or None."""
         for i in todo:
@@ -180,7 +180,7 @@ class ProcessExecutor:
         items: Sequence[T],
         lost: Callable[[T, str], R],
         results: dict[int, R],
-        progress: Progress | None,
+        progress: ItemsDone | None,
     ) -> str | None:
         """Gather ``futures`` into ``results``; return why the pool broke, or None."""
         for future in as_completed(futures):

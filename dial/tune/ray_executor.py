@@ -27,7 +27,7 @@ from types import ModuleType, TracebackType
 from typing import Any, TypeVar, cast
 
 from dial.errors import DialError
-from dial.tune.executor import WORKER_DIED, Initializer, Progress
+from dial.tune.executor import WORKER_DIED, Initializer, ItemsDone
 
 T = TypeVar("T")
 R = TypeVar("R")
@@ -163,7 +163,7 @@ class RayExecutor:
         fn: Callable[[T], R],
         items: Sequence[T],
         lost: Callable[[T, str], R],
-        progress: Progress | None = None,
+        progress: ItemsDone | None = None,
     ) -> list[R]:
         # Ray prints its workers' output and its own notes (a worker died, a task is
         # retried) on this process's stdout, which carries the table: send them to stderr.
@@ -181,7 +181,7 @@ class RayExecutor:
         fn: Callable[[T], R],
         items: Sequence[T],
         lost: Callable[[T, str], R],
-        progress: Progress | None,
+        progress: ItemsDone | None,
     ) -> list[R]:
         ray = self.ray
         task = ray.remote(max_retries=RETRIES, retry_exceptions=False)(_run_task)

@@ -14,7 +14,7 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 
 from dial.errors import DialError
-from dial.tune.executor import Executor, Progress
+from dial.tune.executor import Executor, ItemsDone
 from dial.tune.grid import Trial
 
 
@@ -92,7 +92,7 @@ def sweep(
     trials: Sequence[Trial],
     executor: Executor,
     backend: Backend = engine_backend,
-    progress: Progress | None = None,
+    progress: ItemsDone | None = None,
 ) -> list[TrialResult]:
     """Run every trial; results come back in the order of ``trials``, whatever ran first."""
     # Longest ticks first, so that the last trials to finish are short ones and the

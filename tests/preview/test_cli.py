@@ -12,6 +12,8 @@ import pytest
 
 from dial.cli import main
 
+from ..conftest import NEEDS_PLOT
+
 DIAL = [sys.executable, "-m", "dial.cli"]
 
 
@@ -70,6 +72,7 @@ def test_the_storyboard_is_a_png_of_one_panel_per_block(tmp_path: Path) -> None:
     assert (width, height) == (3 * 488 + 8, 44 + 360 + 46 + 8)
 
 
+@NEEDS_PLOT  # without the extra, that is said first
 def test_storyboard_usage_errors(
     tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:

@@ -13,6 +13,8 @@ from dial.resources import resolve_script
 from dial.tune import plan
 from dial.tune.trial import engine_backend, run_trial
 
+from ..conftest import NEEDS_PLOT
+
 
 @pytest.mark.parametrize(
     ("args", "message"),
@@ -70,6 +72,7 @@ def test_an_unwritable_plot_stops_the_sweep_before_it_starts(
     assert captured.out == ""  # no trial ran
 
 
+@NEEDS_PLOT
 def test_small_lightbulb_sweep_prints_table_json_and_plot(
     in_root: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

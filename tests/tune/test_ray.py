@@ -13,6 +13,8 @@ from io import StringIO
 from pathlib import Path
 
 import pytest
+
+pytest.importorskip("ray", reason="the 'ray' extra is not installed: pip install -e '.[ray]'")
 import ray
 import ray.cloudpickle
 

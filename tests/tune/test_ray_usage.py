@@ -21,6 +21,8 @@ from dial.cli import main
 from dial.tune import ray_executor
 from dial.tune.ray_executor import RayConnectError
 
+from ..conftest import NEEDS_RAY
+
 TUNE = ["tune", "lightbulb", "--ticks", "0.1:0.2:2"]
 
 
@@ -51,6 +53,7 @@ def test_executor_ray_without_ray_installed_names_the_install_command(
     assert err.count("\n") == 1
 
 
+@NEEDS_RAY  # without Ray, that is said first
 @pytest.mark.parametrize(
     ("args", "message"),
     [
@@ -75,6 +78,7 @@ def test_address_without_executor_ray_is_a_usage_error(
     assert capsys.readouterr().err == "dial: --address needs --executor ray\n"
 
 
+@NEEDS_RAY
 def test_an_address_where_nothing_listens_is_one_line_at_once(
     capsys: pytest.CaptureFixture[str],
 ) -> None:

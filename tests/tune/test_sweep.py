@@ -26,6 +26,7 @@ from dial.tune import (
 )
 from dial.tune.executor import WORKER_DIED
 
+from ..conftest import NEEDS_PLOT
 from . import helpers
 
 GRID = parse_ticks("0.05:0.5:10")
@@ -136,6 +137,7 @@ def test_tune_plot_without_matplotlib_prints_the_table_and_exits_1(
     assert not (tmp_path / "p.png").exists()
 
 
+@NEEDS_PLOT  # without matplotlib, that is said instead
 def test_tune_plot_that_cannot_be_written_is_reported_after_the_table(tmp_path: Path) -> None:
     status, out, err = _tune(tmp_path, "0.25:0.3:2", plot=tmp_path / "no" / "p.png")
     assert status == 1
