@@ -7,13 +7,15 @@ The public API (docs/api.md)::
     result = dial.run(dial.load("pour.dial"), perturb=10, seed=3)
     print(result.ok, result.success)
 
-``import dial`` loads nothing but this file: each name below is imported from its module on
-first use (``dial.load`` brings the parser, ``dial.run`` the engine, MuJoCo on the first run),
-so that ``dial --help`` and ``dial check`` start quickly (docs/architecture.md).
+``import dial`` loads nothing but this file (and ``dial.lazy``): each name below is imported
+from its module on first use (``dial.load`` brings the parser, ``dial.run`` the engine,
+MuJoCo on the first run), so that ``dial --help`` and ``dial check`` start quickly
+(docs/architecture.md).
 """
 
-from importlib import import_module
 from typing import TYPE_CHECKING
+
+from dial.lazy import lazy_names
 
 if TYPE_CHECKING:
     from dial.api import load, run
@@ -51,15 +53,7 @@ _HOMES = {
     "Watched": "dial.engine",
 }
 
-
-def __getattr__(name: str) -> object:
-    """A public name, imported from its module when first used."""
-    home = _HOMES.get(name)
-    if home is None:
-        raise AttributeError(f"module 'dial' has no attribute '{name}'")
-    value = getattr(import_module(home), name)
-    globals()[name] = value
-    return value
+__getattr__ = lazy_names(__name__, _HOMES)
 
 
 def __dir__() -> list[str]:

@@ -5,8 +5,9 @@ trio, which the modules that only need the types (the primitives, the preview, `
 world``) do without.
 """
 
-from importlib import import_module
 from typing import TYPE_CHECKING
+
+from dial.lazy import lazy_names
 
 if TYPE_CHECKING:
     from dial.scheduler.log import EventLog, LogError
@@ -56,12 +57,4 @@ __all__ = [
     "periods_per_tick",
 ]
 
-
-def __getattr__(name: str) -> object:
-    """A public name, imported from its module when first used."""
-    home = _HOME.get(name)
-    if home is None:
-        raise AttributeError(f"module 'dial.scheduler' has no attribute '{name}'")
-    value = getattr(import_module(home), name)
-    globals()[name] = value
-    return value
+__getattr__ = lazy_names(__name__, _HOME)
