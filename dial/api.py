@@ -90,7 +90,7 @@ def writable(path: str | Path, what: str) -> Path:
 
 
 @contextmanager
-def _log_sink(log: str | Path | TextIO | None) -> Iterator[TextIO | None]:
+def log_sink(log: str | Path | TextIO | None) -> Iterator[TextIO | None]:
     if log is None or not isinstance(log, str | Path):
         yield log
         return
@@ -142,7 +142,7 @@ def run(
     from dial.engine import run as run_engine
 
     stops, console = _pausing(script, breaks, step, console)
-    with _log_sink(log) as sink:
+    with log_sink(log) as sink:
         options = RunOptions(
             tick=tick,
             speed=speed,

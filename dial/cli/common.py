@@ -17,6 +17,8 @@ if TYPE_CHECKING:
     from dial.parser.script import Script
 
 UsageError = OptionError  # a usage problem: exit status 2
+# Set by a command whose process must end at once after its last word (dial run --remote).
+EXIT_AT_ONCE = False
 
 
 def load_script(arg: str, scene: str | None) -> Script:

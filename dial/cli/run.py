@@ -8,8 +8,9 @@ import sys
 from collections.abc import Callable
 from typing import TYPE_CHECKING
 
-from dial.cli.common import UsageError, scene_argument
-from dial.scheduler.signals import EXIT_STATUS, catch_stop_signals
+from dial.cli.common import UsageError, load_script, scene_argument
+from dial.cli.remote import add_run_options, check_remote
+from dial.scheduler.signals import EXIT_STATUS, StopRequest, catch_stop_signals
 
 if TYPE_CHECKING:  # what a run needs loads when it runs: `dial --help` stays quick
     from dial.engine import RunResult
@@ -108,6 +109,7 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         help="go on from a state file (with its tick, seed, perturbation and disturbances); "
         "lines of the script before the saved block must be unchanged",
     )
+    add_run_options(p)
     p.set_defaults(func=cmd_run)
 
 
@@ -115,7 +117,10 @@ def cmd_run(args: argparse.Namespace) -> int:
     # The command owns the stop signals from here to the exit: one stops the run (dial.run
     # checks the options, then the script, then runs it) or, once the run is over, is
     # ignored: a second Ctrl-C cannot cut the summary or the log short.
-    with catch_stop_signals():
+    check_remote(args)
+    with catch_stop_signals() as stop:
+        if args.remote is not None:
+            return _remote(args, stop)
         return _run(args)
 
 
@@ -175,6 +180,19 @@ def _run(args: argparse.Namespace) -> int:
         )
         return 1
     return 0 if result.ok else 1
+
+
+def _remote(args: argparse.Namespace, stop: StopRequest) -> int:
+    """``dial run --remote``: the options and the script checked here, then the robot's run."""
+    from dial import api
+    from dial.cli.run_remote import run_remote
+
+    api.check_options(args.tick, args.speed, args.seed, args.perturb)
+    script = load_script(args.script, args.scene)
+    if stop.signal is not None:  # while the script was being checked
+        print(f"dial: interrupted by {stop.signal}", file=sys.stderr)
+        return EXIT_STATUS[stop.signal]
+    return run_remote(args, script, stop, _progress(args.quiet), summary_text)
 
 
 def _save_at(value: list[str] | None) -> tuple[int, str] | None:

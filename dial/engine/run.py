@@ -50,6 +50,7 @@ class RunOptions:
     perturb_mm: float = 0.0
     disturb: Sequence[Disturbance] = ()
     realtime: bool = False
+    pace: float | None = None  # wall s per simulated s (--realtime is 1); None: unpaced
     log: TextIO | None = None  # the JSON Lines sink, written and flushed record by record
     log_states: bool = False
     progress: Progress | None = None
@@ -60,6 +61,7 @@ class RunOptions:
     console: Console | None = None
     save_at: tuple[int, Path] | None = None  # (block number, state file)
     resume: StateFile | None = None  # a state file to go on from (its settings win)
+    stop: StopRequest | None = None  # polled every period (a remote session's); else signals'
 
 
 def tick_length(script: Script, options: RunOptions) -> float:
@@ -83,7 +85,8 @@ def run(script: Script, options: RunOptions) -> RunResult:
     SIGINT and SIGTERM stop the run at the next control period, from the scene's loading on:
     every effector holds, and the log ends with ``interrupted`` and ``summary``.
     """
-    with catch_stop_signals() as stop:
+    with catch_stop_signals() as signals:
+        stop = options.stop if options.stop is not None else signals
         log = EventLog(options.log)
         settings = _settings(script, options)
         drawn = bool(options.observers)  # an observer may draw: it gets the scene's textures
@@ -111,7 +114,7 @@ def run(script: Script, options: RunOptions) -> RunResult:
                 log,
                 progress=options.progress,
                 observe=fan_out(begun),
-                pace=1.0 if options.realtime else None,
+                pace=1.0 if options.realtime else options.pace,
                 stop=stop,
                 hooks=hooks,
             )

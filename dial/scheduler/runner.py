@@ -106,8 +106,7 @@ class Runner(Generic[S]):
         try:
             if self.stop.signal is not None:  # it came while the scene was being prepared
                 raise Interrupted(self.stop.signal)
-            path = resume.path if resume is not None else ()
-            await self._walk(loop, script, script.timeline, path)
+            await self._main(loop, script, resume.path if resume is not None else ())
         except RunAborted as e:
             error = e
             records.error(e.event, e.tick, loop.sim_time, str(e))
@@ -129,6 +128,11 @@ class Runner(Generic[S]):
             dict(sorted(loop.counts.items())),
             interrupted,
         )
+
+    async def _main(self, loop: TickLoop[S], script: Script, path: TimelinePath) -> None:
+        """The run's body: the timeline's walk (a remote robot takes blocks from its operator
+        instead, dial/remote/blocks.py)."""
+        await self._walk(loop, script, script.timeline, path)
 
     # -- the timeline walk ------------------------------------------------------------------------
     async def _walk(
