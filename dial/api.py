@@ -29,6 +29,8 @@ from dial.scene import load_scene_names
 from dial.scene.resolve import scene_option
 
 if TYPE_CHECKING:  # trio and MuJoCo load only to run: `import dial` and checking stay light
+    from dial.dataset.plan import Request
+    from dial.dataset.writer import DatasetWriter
     from dial.debug import Break, Console
     from dial.disturb import Disturbance
     from dial.engine import Observer, RunResult
@@ -128,6 +130,9 @@ def run(
     save_at: tuple[int, str | Path] | None = None,
     resume: str | Path | None = None,
     console: Console | None = None,
+    dataset: str | Path | DatasetWriter | None = None,
+    fps: int | None = None,
+    cameras: Sequence[str] = (),
 ) -> RunResult:
     """Run a script in its scene, as ``dial run`` does, and return its :class:`RunResult`.
 
@@ -137,12 +142,13 @@ def run(
     """
     items, saved = _checked(tick, speed, seed, perturb, disturb, save_at, resume)
     _check_watching(record, video, rerun, viewer)  # before the script: usage comes first
+    request = _dataset_request(dataset, fps, cameras)
     script = _script(script, scene)
     from dial.engine import RunOptions
     from dial.engine import run as run_engine
 
     stops, console = _pausing(script, breaks, step, console)
-    with log_sink(log) as sink:
+    with log_sink(log) as sink, _recording(dataset, request, script, saved, perturb) as recorder:
         options = RunOptions(
             tick=tick,
             speed=speed,
@@ -153,7 +159,7 @@ def run(
             log=sink,
             log_states=log_states,
             progress=progress,
-            observers=[*_watchers(record, video, rerun, viewer, script), *observers],
+            observers=[*_watchers(record, video, rerun, viewer, script), *observers, *recorder],
             breaks=stops,
             step=step,
             console=console,
@@ -190,6 +196,45 @@ def _checked(
             raise OptionError(f"--save-at block:N needs N >= 1, got {save_at[0]}")
         writable(save_at[1], "the state file")
     return items, None if resume is None else _load_state(Path(resume))
+
+
+def _dataset_request(
+    dataset: str | Path | DatasetWriter | None, fps: int | None, cameras: Sequence[str]
+) -> Request | None:
+    """What ``dataset=`` asks (checked: a usage error before anything runs), or None."""
+    if dataset is None:
+        if fps is not None or cameras:
+            raise OptionError("fps= and cameras= go with dataset=")
+        return None
+    from dial.dataset.plan import Request, check_request
+    from dial.dataset.writer import DatasetWriter
+
+    if isinstance(dataset, DatasetWriter) and fps is not None and fps != dataset.fps:
+        raise OptionError(f"fps={fps}: the dataset writer writes at {dataset.fps} fps")
+    default = dataset.fps if isinstance(dataset, DatasetWriter) else 50
+    request = Request(default if fps is None else fps, tuple(cameras))
+    check_request(request)
+    return request
+
+
+@contextmanager
+def _recording(
+    dataset: str | Path | DatasetWriter | None,
+    request: Request | None,
+    script: Script,
+    saved: StateFile | None,
+    perturb_mm: float,
+) -> Iterator[list[Observer]]:
+    """The dataset's recorder as a list of observers (empty without ``dataset=``); a
+    resumed run's perturbation is its state file's."""
+    if dataset is None or request is None:
+        yield []
+        return
+    from dial.dataset.session import recording
+
+    moved = saved.settings.perturb_mm if saved is not None else perturb_mm
+    with recording(dataset, request, script, moved) as recorder:
+        yield [recorder]
 
 
 def _script(script: Script | str | Path, scene: str | None) -> Script:

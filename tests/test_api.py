@@ -16,11 +16,11 @@ API_DOC = (ROOT / "docs" / "api.md").read_text(encoding="utf-8")
 EXAMPLES = re.findall(r"```python\n(.*?)```", API_DOC, flags=re.S)
 
 
-def test_the_docs_have_two_examples() -> None:
-    assert len(EXAMPLES) == 2
+def test_the_docs_have_three_examples() -> None:
+    assert len(EXAMPLES) == 3
 
 
-@pytest.mark.parametrize("example", EXAMPLES, ids=["run", "observer"])
+@pytest.mark.parametrize("example", EXAMPLES, ids=["run", "observer", "dataset"])
 def test_each_example_runs_as_written(example: str, tmp_path: object) -> None:
     done = subprocess.run(
         [sys.executable, "-c", example], capture_output=True, text=True, timeout=300

@@ -7,6 +7,7 @@ right to left: the last module is the one this command imported)."""
 
 from __future__ import annotations
 
+import importlib.util
 import os
 import subprocess
 import sys
@@ -17,6 +18,7 @@ import pytest
 from tests.conftest import ROOT, SHORT
 
 HEAVY = ("mujoco", "scipy", "rerun", "mink", "qpsolvers", "trio", "pyarrow", "ray", "matplotlib")
+DATASET = "dial.dataset"  # counted as heavy too: it is for --dataset alone
 PROGRAM = "import sys; from dial.cli import main; sys.exit(main())"  # as the installed `dial`
 POUR = str(ROOT / "scripts" / "pour.dial")
 RUN_NEEDS = {"mujoco", "trio"}  # the physics and the runner
@@ -34,8 +36,8 @@ def chains(report: str) -> dict[str, str]:
                 rows.append(((len(name) - len(name.lstrip()) - 1) // 2, name.strip()))
     found: dict[str, str] = {}
     for i, (depth, name) in enumerate(rows):
-        top = name.split(".")[0]
-        if top in HEAVY and top not in found:
+        top = DATASET if f"{name}.".startswith(f"{DATASET}.") else name.split(".")[0]
+        if (top in HEAVY or top == DATASET) and top not in found:
             chain = [name]
             for outer, importer in rows[i + 1 :]:
                 if outer < depth:
@@ -103,6 +105,31 @@ def test_import_dial_loads_nothing_but_itself(tmp_path: Path) -> None:
 
 
 @pytest.mark.parametrize(
+    ("args", "drawing"),
+    [
+        (["run", POUR], False),
+        (["run", POUR, "--dataset", "d"], False),
+        (["run", POUR, "--dataset", "d", "--cameras", "task"], True),
+        (["tune", POUR, "--ticks", "0.1:0.2:2", "--dataset", "d", "--cameras", "task"], True),
+        (["run", POUR, "--video", "v.mp4"], True),
+        (["run", POUR, "--viewer"], True),
+        (["preview", POUR, "--storyboard", "s.png"], True),
+        (["world", "pour", "--picture", "p.png"], True),
+        (["teach", "--scene", "surface", "--snapshot", "d"], True),
+        (["teach", "--scene", "surface"], False),
+        (["replay", "run.jsonl", "--video", "v.mp4"], True),
+        (["check", POUR], False),
+    ],
+)
+def test_the_program_lets_mujoco_find_opengl_only_when_an_option_draws(
+    args: list[str], drawing: bool
+) -> None:
+    from dial.cli import build_parser, draws
+
+    assert draws(build_parser().parse_args(args)) is drawing
+
+
+@pytest.mark.parametrize(
     "args",
     [["--help"], ["check", POUR], ["show", POUR], ["fmt", "--check", POUR], ["run", "--help"]],
     ids=["help", "check", "show", "fmt", "run-help"],
@@ -111,13 +138,19 @@ def test_the_commands_on_text_load_no_heavy_package(args: list[str], tmp_path: P
     expect(loads(args, tmp_path), set(), f"dial {' '.join(args)}")
 
 
-def test_a_run_loads_the_ik_solvers_only_for_problems_it_has_not_met(tmp_path: Path) -> None:
+def test_a_run_loads_the_ik_solvers_for_new_problems_only_and_pyarrow_for_datasets(
+    tmp_path: Path,
+) -> None:
     script = tmp_path / "short.dial"
     script.write_text(SHORT)
     cache = tmp_path / "cache"
     run = ["run", str(script), "--quiet"]
     expect(loads(run, cache), RUN_NEEDS | SOLVING, "dial run (an empty IK cache)")
     expect(loads(run, cache), RUN_NEEDS, "dial run (its IK problems in the cache)")
+    if importlib.util.find_spec("pyarrow") is not None:  # the 'dataset' extra (in 'test')
+        dataset = [*run, "--dataset", str(tmp_path / "data")]
+        expect(loads(dataset, cache), RUN_NEEDS | {"pyarrow", DATASET}, "dial run --dataset")
+        assert (tmp_path / "data" / "meta" / "info.json").is_file()  # it wrote the episode
     (tmp_path / "a_file").write_text("")  # a cache folder that cannot be made: still runs
     expect(loads(run, tmp_path / "a_file"), RUN_NEEDS | SOLVING, "dial run, no cache folder")
 

@@ -67,13 +67,19 @@ def main(argv: Sequence[str] | None = None) -> int:
     return status
 
 
-# The options that draw with MuJoCo (offscreen or in a window).
-_DRAWING = ("video", "viewer", "snapshot", "picture", "storyboard")
+# The options that draw with MuJoCo (offscreen or in a window); --cameras draws a
+# dataset's videos (dial run, and dial tune's workers, which inherit the environment).
+_DRAWING = ("video", "viewer", "snapshot", "picture", "storyboard", "cameras")
+
+
+def draws(args: argparse.Namespace) -> bool:
+    """Whether the parsed command draws with MuJoCo (else ``dial`` sets MUJOCO_GL=disable)."""
+    return any(getattr(args, name, None) for name in _DRAWING)
 
 
 def _main(argv: Sequence[str] | None) -> int:
     args = build_parser().parse_args(argv)
-    if argv is None and not any(getattr(args, name, None) for name in _DRAWING):
+    if argv is None and not draws(args):
         # Nothing is drawn: MuJoCo need not look for an OpenGL library when it loads (on
         # Linux its GLFW binding starts a Python process per library it finds, 0.1 s).
         os.environ.setdefault("MUJOCO_GL", "disable")

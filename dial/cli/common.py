@@ -54,6 +54,56 @@ def plot_usage(flag: str) -> None:
         raise UsageError(problem)
 
 
+def dataset_arguments(p: argparse.ArgumentParser, sweep: bool) -> None:
+    """``--dataset DIR`` and its options, for ``dial run`` and ``dial tune``."""
+    g = p.add_argument_group(
+        "dataset (docs/datasets.md)",
+        "Write the run"
+        + ("s, one episode per trial in trial order," if sweep else "")
+        + " as a LeRobot v3.0 dataset (needs the 'dataset' extra).",
+    )
+    g.add_argument(
+        "--dataset",
+        metavar="DIR",
+        help="write (or append, with the same features) "
+        + ("one episode per trial" if sweep else "the run as one episode")
+        + " into the dataset folder DIR",
+    )
+    g.add_argument(
+        "--fps",
+        type=int,
+        metavar="N",
+        help="frames per simulated second, resampled from the 100 Hz control periods, "
+        "1 <= N <= 100 (default 50)",
+    )
+    g.add_argument(
+        "--cameras",
+        metavar="NAMES",
+        help="also record these cameras as videos, comma-separated: 'task' (the view of "
+        "--video) or a camera of the scene's model (needs the 'video' extra)",
+    )
+    if sweep:
+        g.add_argument(
+            "--successful-only",
+            action="store_true",
+            help="write only the trials that succeeded",
+        )
+
+
+def dataset_request(args: argparse.Namespace) -> tuple[str | None, int | None, list[str]]:
+    """``--dataset``, ``--fps``, ``--cameras``: a usage error if the last two lack the first."""
+    cameras = [c.strip() for c in (args.cameras or "").split(",") if c.strip()]
+    if args.dataset is None:
+        given = [f for f, v in (("--fps", args.fps), ("--cameras", args.cameras)) if v is not None]
+        if getattr(args, "successful_only", False):
+            given.append("--successful-only")
+        if given:
+            raise UsageError(f"{given[0]} goes with --dataset DIR")
+    if args.cameras is not None and not cameras:
+        raise UsageError("--cameras: expected camera names, comma-separated")
+    return args.dataset, args.fps, cameras
+
+
 class Terminated(KeyboardInterrupt):
     """SIGTERM, raised where Ctrl-C would be, so that a command with workers to stop
     (``dial tune``) cleans up the same way; the command line then exits 143."""

@@ -209,6 +209,7 @@ def check_remote(args: argparse.Namespace) -> None:
         "--realtime": args.realtime,
         "--record": args.record,  # not yet: the predicted and the reported robot together
         "--rerun": args.rerun,
+        "--dataset": args.dataset,  # a local run's episode; the robot's telemetry is decimated
     }
     given = [flag for flag, value in local.items() if value]
     if given:

@@ -5,14 +5,22 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from typing import TYPE_CHECKING
 
-from dial.cli.common import UsageError, load_script, scene_argument
+from dial.cli.common import (
+    UsageError,
+    dataset_arguments,
+    dataset_request,
+    load_script,
+    scene_argument,
+)
 from dial.cli.remote import add_run_options, check_remote
 from dial.scheduler.signals import EXIT_STATUS, StopRequest, catch_stop_signals
 
 if TYPE_CHECKING:  # what a run needs loads when it runs: `dial --help` stays quick
+    from dial.dataset.writer import DatasetWriter
     from dial.engine import RunResult
 
 DESCRIPTION = (
@@ -109,6 +117,7 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         help="go on from a state file (with its tick, seed, perturbation and disturbances); "
         "lines of the script before the saved block must be unchanged",
     )
+    dataset_arguments(p, sweep=False)
     add_run_options(p)
     p.set_defaults(func=cmd_run)
 
@@ -125,12 +134,26 @@ def cmd_run(args: argparse.Namespace) -> int:
 
 
 def _run(args: argparse.Namespace) -> int:
-    from dial import api  # the parser and the engine: not for --help
-
     if args.log_states and not args.log:
         raise UsageError("--log-states writes into the log: give --log FILE.jsonl too")
     save_at = _save_at(args.save_at)
-    result = api.run(
+    folder, fps, cameras = dataset_request(args)
+    with _dataset(folder, fps) as writer:
+        result = _run_api(args, save_at, writer, cameras)
+    if writer is not None and folder is not None:
+        _said_written(writer, folder)
+    return _report(args, result, save_at)
+
+
+def _run_api(
+    args: argparse.Namespace,
+    save_at: tuple[int, str] | None,
+    writer: DatasetWriter | None,
+    cameras: list[str],
+) -> RunResult:
+    from dial import api  # the parser and the engine: not for --help
+
+    return api.run(
         args.script,
         scene=args.scene,
         tick=args.tick,
@@ -150,7 +173,35 @@ def _run(args: argparse.Namespace) -> int:
         step=args.step,
         save_at=save_at,
         resume=args.resume,
+        dataset=writer,
+        cameras=cameras,
     )
+
+
+@contextmanager
+def _dataset(folder: str | None, fps: int | None) -> Iterator[DatasetWriter | None]:
+    """``--dataset DIR``'s writer, open for the run (closing it commits the episode)."""
+    if folder is None:
+        yield None
+        return
+    from dial.dataset.writer import DatasetWriter
+
+    with DatasetWriter(folder, fps=50 if fps is None else fps) as writer:
+        yield writer
+
+
+def _said_written(writer: DatasetWriter, folder: str) -> None:
+    if writer.added:
+        print(
+            f"dial: episode {writer.episodes - 1} ({writer.last_frames} frames) written to "
+            f"{folder}; it holds {writer.episodes} episodes",
+            file=sys.stderr,
+        )
+    else:
+        print(f"dial: no episode written to {folder} (the run did not finish)", file=sys.stderr)
+
+
+def _report(args: argparse.Namespace, result: RunResult, save_at: tuple[int, str] | None) -> int:
     for number, target in result.saved:
         print(f"dial: saved the state before block {number} to {target}", file=sys.stderr)
     if not args.quiet and sys.stderr.isatty():

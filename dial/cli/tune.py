@@ -4,8 +4,19 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from dial.cli.common import UsageError, at_least, scene_argument, sigterm_as_interrupt
+from dial.cli.common import (
+    UsageError,
+    at_least,
+    dataset_arguments,
+    dataset_request,
+    scene_argument,
+    sigterm_as_interrupt,
+)
+
+if TYPE_CHECKING:
+    from dial.dataset.plan import Request
 
 
 def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
@@ -65,6 +76,7 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
     )
     p.add_argument("--plot", metavar="FILE.png", help="plot success rate and task time")
     p.add_argument("--json", action="store_true", help="print the table as JSON, last line")
+    dataset_arguments(p, sweep=True)
     p.set_defaults(func=cmd_tune)
 
 
@@ -92,6 +104,7 @@ def cmd_tune(args: argparse.Namespace) -> int:
         scene = None if args.scene is None else scene_option(args.scene)
     except SceneNotFoundError as e:
         raise UsageError(str(e)) from None
+    dataset, request = _dataset(args)
     options = TuneOptions(
         script=args.script,
         scene=scene,
@@ -102,6 +115,8 @@ def cmd_tune(args: argparse.Namespace) -> int:
         plot=Path(args.plot) if args.plot else None,
         json=args.json,
         disturb=tuple(args.disturb),
+        dataset=dataset,
+        request=request,
     )
     # Each worker compiles a model file once and gives each trial a copy (dial.tune.models).
     if args.executor == "process":
@@ -118,3 +133,15 @@ def cmd_tune(args: argparse.Namespace) -> int:
         raise UsageError(str(e)) from None
     with sigterm_as_interrupt():
         return tune(options, executor)
+
+
+def _dataset(args: argparse.Namespace) -> tuple[Path | None, Request | None]:
+    """``--dataset`` and its options, checked before any trial runs."""
+    folder, fps, cameras = dataset_request(args)
+    if folder is None:
+        return None, None
+    from dial.dataset.plan import Request, check_request
+
+    request = Request(50 if fps is None else fps, tuple(cameras), args.successful_only)
+    check_request(request)
+    return Path(folder), request

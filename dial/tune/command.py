@@ -6,11 +6,11 @@ import json
 import shutil
 import sys
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import TextIO
+from typing import TYPE_CHECKING, TextIO
 
 from dial.disturb import parse_disturbance
 from dial.parser.check import load
@@ -20,7 +20,12 @@ from dial.scene.of_script import check_pushes, script_world
 from dial.tune.executor import Executor, ItemsDone
 from dial.tune.grid import Trial, plan
 from dial.tune.report import TickRow, fastest_reliable, render_table, summarise, to_json, verdict
-from dial.tune.trial import Backend, engine_backend, sweep
+from dial.tune.trial import Backend, TrialResult, engine_backend, sweep
+
+if TYPE_CHECKING:
+    from dial.dataset.ordered import InOrder
+    from dial.dataset.plan import Request
+    from dial.parser.script import Script
 
 
 @dataclass(frozen=True)
@@ -34,6 +39,8 @@ class TuneOptions:
     json: bool = False
     scene: str | None = None  # dial run --scene: an absolute path or a bundled name
     disturb: tuple[str, ...] = ()  # dial run --disturb SPECs, checked by tune()
+    dataset: Path | None = None  # --dataset DIR: each trial an episode (docs/datasets.md)
+    request: Request | None = None  # its --fps, --cameras, --successful-only
 
 
 @contextmanager
@@ -59,10 +66,13 @@ def tune(
     """Run the sweep and report it: 0 if some tick length always succeeded, else 1."""
     out, err = out or sys.stdout, err or sys.stderr  # looked up now: tests replace them
     path = resolve_script(options.script)
-    trials = _plan(path, options)
+    script, trials = _plan(path, options)
     start = time.perf_counter()
-    with _progress_bar(len(trials), err) as progress:
-        results = sweep(trials, executor, backend, progress)
+    with _progress_bar(len(trials), err) as progress, _episodes(options, script) as sink:
+        each = None if sink is None else _writing(sink)
+        results = sweep(trials, executor, backend, progress, each)
+        if sink is not None:
+            _said_written(sink, options, err)
     wall = time.perf_counter() - start
     where = getattr(executor, "where", "")  # e.g. "on 2 worker processes"
     print(f"dial: {len(trials)} trials in {wall:.1f} s wall {where}".rstrip(), file=err)
@@ -97,13 +107,13 @@ def tune(
     return status
 
 
-def _plan(path: Path, options: TuneOptions) -> list[Trial]:
+def _plan(path: Path, options: TuneOptions) -> tuple[Script, list[Trial]]:
     """Check the script and the options as ``dial run`` would, then list the trials: an
     error never starts a sweep."""
     script = load(path, loader=load_scene_names, scene=options.scene)
     if options.disturb:
         check_pushes([parse_disturbance(d) for d in options.disturb], script_world(script))
-    return plan(
+    return script, plan(
         str(path.resolve()),
         str(path),
         options.ticks,
@@ -112,6 +122,44 @@ def _plan(path: Path, options: TuneOptions) -> list[Trial]:
         options.perturb_mm,
         options.scene,
         options.disturb,
+        options.request if options.dataset is not None else None,
+    )
+
+
+@contextmanager
+def _episodes(options: TuneOptions, script: Script) -> Iterator[InOrder | None]:
+    """The dataset's writer, checked against the trials' features before any runs; it
+    commits what was written however the sweep ends (a failed write has rolled back)."""
+    if options.dataset is None:
+        yield None
+        return
+    from dial.dataset.ordered import InOrder
+    from dial.dataset.plan import Request, expected_features
+    from dial.dataset.writer import DatasetWriter
+
+    request = options.request or Request()
+    with DatasetWriter(options.dataset, fps=request.fps) as writer:
+        writer.check(expected_features(script_world(script), request))
+        yield InOrder(writer)
+
+
+def _writing(sink: InOrder) -> Callable[[int, TrialResult], TrialResult]:
+    """Hand each trial's episode to the dataset as it arrives; keep the result without it."""
+
+    def each(k: int, result: TrialResult) -> TrialResult:
+        sink.put(k, result.episode)
+        return replace(result, episode=None) if result.episode is not None else result
+
+    return each
+
+
+def _said_written(sink: InOrder, options: TuneOptions, err: TextIO) -> None:
+    writer = sink.writer
+    left = f", {sink.skipped} unsuccessful trial(s) left out" if sink.skipped else ""
+    print(
+        f"dial: {sink.written} episode(s) written to {options.dataset}{left}; it holds "
+        f"{writer.episodes} episodes, {writer.frames} frames",
+        file=err,
     )
 
 

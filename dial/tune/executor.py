@@ -23,6 +23,10 @@ T = TypeVar("T")
 R = TypeVar("R")
 
 ItemsDone = Callable[[int], None]  # called with the number of items done so far
+# Called in the caller's process with each item's index and result as it arrives (in the
+# order they finish); what it returns is kept instead (a dataset writes a trial's frames
+# and keeps the rest, so that results do not pile up in memory).
+Each = Callable[[int, R], R]
 Initializer = Callable[[], None]  # run once in each worker process before its first item
 
 # The reason given for an item that killed its worker every time it ran, whatever the
@@ -37,11 +41,13 @@ class Executor(Protocol):
         items: Sequence[T],
         lost: Callable[[T, str], R],
         progress: ItemsDone | None = None,
+        each: Each[R] | None = None,
     ) -> list[R]:
         """``[fn(item) for item in items]``, in item order, however they are run.
 
         ``fn`` and the items must be picklable. ``lost(item, reason)`` stands in
-        for the result of an item whose worker died.
+        for the result of an item whose worker died. ``each(index, result)``, if
+        given, sees every result once as it arrives, and its value is kept.
         """
         ...
 
@@ -55,10 +61,12 @@ class SerialExecutor:
         items: Sequence[T],
         lost: Callable[[T, str], R],
         progress: ItemsDone | None = None,
+        each: Each[R] | None = None,
     ) -> list[R]:
         results = []
-        for item in items:
-            results.append(fn(item))
+        for i, item in enumerate(items):
+            result = fn(item)
+            results.append(result if each is None else each(i, result))
             if progress is not None:
                 progress(len(results))
         return results
@@ -126,24 +134,23 @@ class ProcessExecutor:
         items: Sequence[T],
         lost: Callable[[T, str], R],
         progress: ItemsDone | None = None,
+        each: Each[R] | None = None,
     ) -> list[R]:
         started = self._context().RawArray(ctypes.c_bool, max(len(items), 1))
-        results: dict[int, R] = {}
+        results: _Results[R] = _Results(each, progress)
         todo = list(range(len(items)))
         while todo:
             workers = min(self.jobs, len(todo))
-            if self._run(fn, items, lost, todo, workers, started, results, progress) is None:
+            if self._run(fn, items, lost, todo, workers, started, results) is None:
                 break
             # The pool broke: a suspect is an item that had started and has no result (if
             # none had, the first one left, which may kill its worker before it starts).
             left = [i for i in todo if i not in results]
             for i in [i for i in left if started[i]] or left[:1]:
-                if self._run(fn, items, lost, [i], 1, started, results, progress) is not None:
-                    results[i] = lost(items[i], WORKER_DIED)  # it killed its worker alone
-                    if progress is not None:
-                        progress(len(results))
+                if self._run(fn, items, lost, [i], 1, started, results) is not None:
+                    results.put(i, lost(items[i], WORKER_DIED))  # it killed its worker alone
             todo = [i for i in todo if i not in results]
-        return [results[i] for i in range(len(items))]
+        return results.in_order(len(items))
 
     def _run(
         self,
@@ -153,8 +160,7 @@ class ProcessExecutor:
         todo: list[int],
         workers: int,
         started: ctypes.Array[ctypes.c_bool],
-        results: dict[int, R],
-        progress: ItemsDone | None,
+        results: _Results[R],
     ) -> str | None:
         """Run ``todo`` in a fresh pool of ``workers``; return why the pool broke, or None."""
         for i in todo:
@@ -167,7 +173,7 @@ class ProcessExecutor:
         )
         futures: dict[Future[R], int] = {pool.submit(_call, fn, i, items[i]): i for i in todo}
         try:
-            broken = self._collect(futures, items, lost, results, progress)
+            broken = self._collect(futures, items, lost, results)
         except BaseException:  # an interrupt: stop now, so that a second one finds no wait
             _stop_now(pool)
             raise
@@ -179,24 +185,39 @@ class ProcessExecutor:
         futures: dict[Future[R], int],
         items: Sequence[T],
         lost: Callable[[T, str], R],
-        results: dict[int, R],
-        progress: ItemsDone | None,
+        results: _Results[R],
     ) -> str | None:
-        """Gather ``futures`` into ``results``; return why the pool broke, or None."""
+        """Gather ``futures`` into ``results``; return why the pool broke, or None. A future
+        is let go once its result is kept, so results do not pile up here."""
         for future in as_completed(futures):
-            i = futures[future]
+            i = futures.pop(future)
             try:
-                results[i] = future.result()
+                result = future.result()
             except BrokenProcessPool as e:
                 for other, j in futures.items():  # keep what finished before the break
                     if other.done() and not other.cancelled() and other.exception() is None:
-                        results[j] = other.result()
+                        results.put(j, other.result())
                 return str(e) or type(e).__name__
             except Exception as e:  # fn raised, or an item or result did not pickle
-                results[i] = lost(items[i], f"{type(e).__name__}: {e}")
-            if progress is not None:
-                progress(len(results))
+                result = lost(items[i], f"{type(e).__name__}: {e}")
+            results.put(i, result)
         return None
+
+
+class _Results(dict[int, R]):
+    """Results by item index: each one seen by ``each`` and counted by ``progress``."""
+
+    def __init__(self, each: Each[R] | None, progress: ItemsDone | None) -> None:
+        super().__init__()
+        self.each, self.progress = each, progress
+
+    def put(self, i: int, result: R) -> None:
+        self[i] = result if self.each is None else self.each(i, result)
+        if self.progress is not None:
+            self.progress(len(self))
+
+    def in_order(self, n: int) -> list[R]:
+        return [self[i] for i in range(n)]
 
 
 def _stop_now(pool: ProcessPoolExecutor) -> None:

@@ -6,6 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from dial.dataset.plan import Request
 from dial.parser.parse import MAX_TICK_S
 from dial.units import UnitError, parse_number, parse_quantity
 
@@ -26,6 +27,7 @@ class Trial:
     perturb_mm: float
     scene: str | None = None  # replaces the script's @scene, as dial run --scene
     disturb: tuple[str, ...] = ()  # dial run --disturb SPECs, the same in every trial
+    dataset: Request | None = None  # record the run as a dataset's episode
 
 
 def parse_ticks(text: str) -> tuple[float, ...]:
@@ -72,11 +74,12 @@ def plan(
     perturb_mm: float = 0.0,
     scene: str | None = None,
     disturb: tuple[str, ...] = (),
+    dataset: Request | None = None,
 ) -> list[Trial]:
     """Every trial of the sweep, tick by tick."""
     seeds = [trial_seed(seed, k) for k in range(trials)]
     return [
-        Trial(script, display, tick, k, seeds[k], perturb_mm, scene, disturb)
+        Trial(script, display, tick, k, seeds[k], perturb_mm, scene, disturb, dataset)
         for tick in ticks
         for k in range(trials)
     ]

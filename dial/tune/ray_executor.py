@@ -27,7 +27,7 @@ from types import ModuleType, TracebackType
 from typing import Any, TypeVar, cast
 
 from dial.errors import DialError
-from dial.tune.executor import WORKER_DIED, Initializer, ItemsDone
+from dial.tune.executor import WORKER_DIED, Each, Initializer, ItemsDone
 
 T = TypeVar("T")
 R = TypeVar("R")
@@ -164,6 +164,7 @@ class RayExecutor:
         items: Sequence[T],
         lost: Callable[[T, str], R],
         progress: ItemsDone | None = None,
+        each: Each[R] | None = None,
     ) -> list[R]:
         # Ray prints its workers' output and its own notes (a worker died, a task is
         # retried) on this process's stdout, which carries the table: send them to stderr.
@@ -171,7 +172,7 @@ class RayExecutor:
             opened = not self._opened
             self.connect()
             try:
-                return self._map(fn, items, lost, progress)
+                return self._map(fn, items, lost, progress, each)
             finally:
                 if opened:
                     self.close()
@@ -182,6 +183,7 @@ class RayExecutor:
         items: Sequence[T],
         lost: Callable[[T, str], R],
         progress: ItemsDone | None,
+        each: Each[R] | None,
     ) -> list[R]:
         ray = self.ray
         task = ray.remote(max_retries=RETRIES, retry_exceptions=False)(_run_task)
@@ -192,9 +194,10 @@ class RayExecutor:
             while pending:
                 # Waiting with no timeout would hold off Ctrl-C until a result arrives.
                 done, pending = ray.wait(pending, num_returns=1, timeout=WAIT_S)
-                for ref in done:
-                    i = index[ref]
-                    results[i] = self._result(ref, items[i], lost)
+                for ref in done:  # let go of the reference: Ray may free the object
+                    i = index.pop(ref)
+                    result = self._result(ref, items[i], lost)
+                    results[i] = result if each is None else each(i, result)
                     if progress is not None:
                         progress(len(results))
         except BaseException:  # an interrupt: the remaining tasks must not run on

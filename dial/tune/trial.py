@@ -12,10 +12,15 @@ from __future__ import annotations
 import functools
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING
 
 from dial.errors import DialError
-from dial.tune.executor import Executor, ItemsDone
+from dial.tune.executor import Each, Executor, ItemsDone
 from dial.tune.grid import Trial
+
+if TYPE_CHECKING:
+    from dial.dataset.episode import Episode
 
 
 @dataclass(frozen=True)
@@ -26,6 +31,7 @@ class RunReport:
     sim_time: float  # simulated s from the first tick to the end (or the abort)
     tick_length: float  # s, the tick as run: a whole number of control periods
     error: str | None = None  # why the run aborted (timeout, error, safety monitor)
+    episode: Episode | None = None  # the run as a dataset's episode, if the trial asks
 
 
 @dataclass(frozen=True)
@@ -40,6 +46,7 @@ class TrialResult:
     tick_length: float | None
     failed: tuple[str, ...]  # criteria that did not hold
     error: str | None
+    episode: Episode | None = None  # until the parent has written it (dial.tune.episodes)
 
 
 Backend = Callable[[Trial], RunReport]
@@ -56,10 +63,21 @@ def engine_backend(trial: Trial) -> RunReport:
     script = load(trial.script, loader=load_scene_names, display=trial.display, scene=trial.scene)
     disturb = tuple(parse_disturbance(d) for d in trial.disturb)  # texts cross the wire
     options = RunOptions(trial.tick, seed=trial.seed, perturb_mm=trial.perturb_mm, disturb=disturb)
+    recorder = None
+    if trial.dataset is not None:
+        from dial.dataset.recorder import Recorder
+
+        request = trial.dataset
+        name = Path(trial.display).name
+        recorder = Recorder(name, request.fps, request.cameras, trial.perturb_mm)
+        options.observers.append(recorder)
     result = run(script, options)
     summary = result.summary
     error = str(summary.error) if summary.error is not None else None
-    return RunReport(result.success, summary.sim_time, summary.tick_length, error)
+    episode = None if recorder is None else recorder.episode
+    if episode is not None and trial.dataset is not None and trial.dataset.successful_only:
+        episode = episode if result.ok else None  # nothing to send back
+    return RunReport(result.success, summary.sim_time, summary.tick_length, error, episode)
 
 
 def run_trial(backend: Backend, trial: Trial) -> TrialResult:
@@ -80,6 +98,7 @@ def run_trial(backend: Backend, trial: Trial) -> TrialResult:
         report.tick_length,
         failed,
         report.error,
+        report.episode,
     )
 
 
@@ -93,13 +112,24 @@ def sweep(
     executor: Executor,
     backend: Backend = engine_backend,
     progress: ItemsDone | None = None,
+    each: Each[TrialResult] | None = None,
 ) -> list[TrialResult]:
-    """Run every trial; results come back in the order of ``trials``, whatever ran first."""
-    # Longest ticks first, so that the last trials to finish are short ones and the
-    # workers end together (the results are put back in plan order below).
-    order = sorted(range(len(trials)), key=lambda i: (-trials[i].tick, i))
+    """Run every trial; results come back in the order of ``trials``, whatever ran first.
+
+    ``each(k, result)`` sees the result of ``trials[k]`` as it arrives, and its value is
+    kept. With it, the trials start in plan order (a dataset writes them so, and keeps
+    fewer waiting); without it, longest ticks first, so that the last trials to finish are
+    short ones and the workers end together.
+    """
+    order = list(range(len(trials)))
+    if each is None:
+        order.sort(key=lambda i: (-trials[i].tick, i))
     ran = executor.map(
-        functools.partial(run_trial, backend), [trials[i] for i in order], failed_trial, progress
+        functools.partial(run_trial, backend),
+        [trials[i] for i in order],
+        failed_trial,
+        progress,
+        each,
     )
     by_index = dict(zip(order, ran, strict=True))
     return [by_index[i] for i in range(len(trials))]
