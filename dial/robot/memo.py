@@ -75,7 +75,7 @@ class Memo:
         if self._disk is None:
             self._disk = _read(self.fingerprint)
         stored = self._disk.get(key)
-        if stored is None:
+        if stored is None or not _whole(stored):  # an entry as the memo writes one, or a miss
             return None
         self._used[key] = stored
         value = _decoded(stored)
@@ -106,7 +106,7 @@ class Memo:
         if folder is None:
             return
         old = _read(self.fingerprint)
-        merged = {k: v for k, v in old.items() if k not in self._used}
+        merged = {k: v for k, v in old.items() if k not in self._used and _kept(k, v)}
         merged.update(self._used)
         keep = dict(list(merged.items())[-MAX_SAVED:])
         with suppress(OSError, ValueError):
@@ -151,6 +151,8 @@ def cache_dir() -> Path | None:
 
 
 def _read(fingerprint: str) -> dict[Key, Stored]:
+    """The file's entries, as read: each is checked when it is used (:func:`_kept`), so that
+    a file of 20,000 entries costs its reading alone."""
     folder = cache_dir()
     if folder is None:
         return {}
@@ -158,9 +160,12 @@ def _read(fingerprint: str) -> dict[Key, Stored]:
         found = marshal.loads((folder / f"{fingerprint}.marshal").read_bytes())
     except (OSError, EOFError, ValueError, TypeError):
         return {}  # none yet, unreadable or damaged: solve again
-    if not isinstance(found, dict):
-        return {}
-    return {k: v for k, v in found.items() if isinstance(k, tuple) and _whole(v)}
+    return found if isinstance(found, dict) else {}
+
+
+def _kept(key: object, value: object) -> bool:
+    """Whether an entry of a file is as :meth:`Memo.save` writes one."""
+    return isinstance(key, tuple) and _whole(value)
 
 
 def _whole(value: object) -> bool:
