@@ -49,8 +49,9 @@ def _robot_files() -> dict[str, bytes]:
     return {path.name: path.read_bytes() for path in ROBOT_DIR.glob("*.xml")}
 
 
-# Compiled models by (path, mtime) once keep_compiled() is called; None: compile every time.
-_compiled: dict[tuple[str, int], mujoco.MjModel] | None = None
+# Compiled models by (path, mtime, textures) once keep_compiled() is called; None: compile
+# every time.
+_compiled: dict[tuple[str, int, bool], mujoco.MjModel] | None = None
 
 
 def keep_compiled() -> None:
@@ -71,14 +72,16 @@ def compiled_count() -> int:
     return 0 if _compiled is None else len(_compiled)
 
 
-def load_model(path: str | Path = ROBOT_XML) -> mujoco.MjModel:
-    """Compile the robot, or a scene XML file that includes ``utah_hand_puma.xml``."""
+def load_model(path: str | Path = ROBOT_XML, *, textures: bool = True) -> mujoco.MjModel:
+    """Compile the robot, or a scene XML file that includes ``utah_hand_puma.xml``;
+    ``textures=False``: without its textures (:func:`load_untextured`)."""
+    compile_model = _compile if textures else load_untextured
     if _compiled is None:
-        return _compile(path)
-    key = (str(path), os.stat(path).st_mtime_ns)
+        return compile_model(path)
+    key = (str(path), os.stat(path).st_mtime_ns, textures)
     model = _compiled.get(key)
     if model is None:
-        model = _compiled[key] = _compile(path)
+        model = _compiled[key] = compile_model(path)
     return copy.copy(model)
 
 
@@ -90,10 +93,12 @@ def _compile(path: str | Path) -> mujoco.MjModel:
 
 
 def load_untextured(path: str | Path) -> mujoco.MjModel:
-    """Compile a scene without its textures, for what never draws it (``dial preview``).
+    """Compile a scene without its textures, for what never draws it (``dial preview``, and
+    ``dial run`` with no observer).
 
     A scene's skybox and floor textures take most of its compile time; without them only the
-    textures' fields, the materials' references to them and the name addresses differ.
+    textures' fields, the materials' references to them and the name addresses differ: no
+    physics reads them (tests/engine/test_textures.py runs a scene both ways, to the bit).
     """
     try:
         spec = mujoco.MjSpec.from_file(str(path), _robot_files())

@@ -9,10 +9,12 @@ import sys
 from collections.abc import Iterator
 from contextlib import contextmanager
 from types import FrameType
+from typing import TYPE_CHECKING
 
-from dial.api import load
 from dial.errors import OptionError
-from dial.parser.script import Script
+
+if TYPE_CHECKING:
+    from dial.parser.script import Script
 
 UsageError = OptionError  # a usage problem: exit status 2
 # Set by a command whose process must end at once after its last word (dial run --remote).
@@ -21,6 +23,8 @@ EXIT_AT_ONCE = False
 
 def load_script(arg: str, scene: str | None) -> Script:
     """A script argument (a path, else a bundled name), checked against ``--scene``."""
+    from dial.api import load  # the parser: not for --help
+
     return load(arg, scene=scene)
 
 

@@ -9,7 +9,6 @@ from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from typing import TYPE_CHECKING
 
-from dial import api
 from dial.cli.common import (
     UsageError,
     dataset_arguments,
@@ -18,10 +17,9 @@ from dial.cli.common import (
     scene_argument,
 )
 from dial.cli.remote import add_run_options, check_remote
-from dial.recording.timeline import qualified_event
 from dial.scheduler.signals import EXIT_STATUS, StopRequest, catch_stop_signals
 
-if TYPE_CHECKING:
+if TYPE_CHECKING:  # what a run needs loads when it runs: `dial --help` stays quick
     from dial.dataset.writer import DatasetWriter
     from dial.engine import RunResult
 
@@ -154,6 +152,8 @@ def _run_api(
     writer: DatasetWriter | None,
     cameras: list[str],
 ) -> RunResult:
+    from dial import api  # the parser and the engine: not for --help
+
     return api.run(
         args.script,
         scene=args.scene,
@@ -236,6 +236,7 @@ def _report(args: argparse.Namespace, result: RunResult, save_at: tuple[int, str
 
 def _remote(args: argparse.Namespace, stop: StopRequest) -> int:
     """``dial run --remote``: the options and the script checked here, then the robot's run."""
+    from dial import api
     from dial.cli.run_remote import run_remote
 
     api.check_options(args.tick, args.speed, args.seed, args.perturb)
@@ -272,6 +273,8 @@ def _progress(quiet: bool) -> Callable[[int, float, list[str]], None] | None:
 
 def summary_text(result: RunResult) -> str:
     """The table ``dial run`` prints: each run's end, the times, the criteria (pure)."""
+    from dial.recording.timeline import qualified_event
+
     s = result.summary
     lines = [f"scene {result.world.name}: {s.ticks} ticks of {s.tick_length:g} s"]
     ends = result.log.of("end")

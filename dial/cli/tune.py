@@ -6,7 +6,6 @@ import argparse
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from dial import api
 from dial.cli.common import (
     UsageError,
     at_least,
@@ -15,8 +14,6 @@ from dial.cli.common import (
     scene_argument,
     sigterm_as_interrupt,
 )
-from dial.disturb import parse_disturbance
-from dial.instructions.scene_names import SceneNotFoundError
 
 if TYPE_CHECKING:
     from dial.dataset.plan import Request
@@ -84,6 +81,9 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
 
 
 def cmd_tune(args: argparse.Namespace) -> int:
+    from dial import api
+    from dial.disturb import parse_disturbance
+    from dial.instructions.scene_names import SceneNotFoundError
     from dial.scene.resolve import scene_option
     from dial.tune import ProcessExecutor, TuneOptions, models, parse_ticks, tune
 
