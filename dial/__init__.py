@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING
 from dial.lazy import lazy_names
 
 if TYPE_CHECKING:
-    from dial.api import load, run
+    from dial.api import load, run, save_world
     from dial.engine import Observer, RunResult, Watched
     from dial.errors import Diagnostic, DialError, OptionError, ScriptError, Span
     from dial.parser.script import Script
@@ -37,11 +37,13 @@ __all__ = [
     "__version__",
     "load",
     "run",
+    "save_world",
 ]
 # Where each public name lives.
 _HOMES = {
     "load": "dial.api",
     "run": "dial.api",
+    "save_world": "dial.api",
     "Diagnostic": "dial.errors",
     "DialError": "dial.errors",
     "OptionError": "dial.errors",

@@ -133,23 +133,22 @@ def run(
     dataset: str | Path | DatasetWriter | None = None,
     fps: int | None = None,
     cameras: Sequence[str] = (),
+    follow_grasps: bool = True,
 ) -> RunResult:
     """Run a script in its scene, as ``dial run`` does, and return its :class:`RunResult`.
 
     ``script``: a :class:`Script` from :func:`load`, or a path or bundled name to load (with
-    ``scene``). The keywords are ``dial run``'s options, each described in docs/api.md. A
-    stop signal (SIGINT, SIGTERM) ends the run cleanly: ``result.summary.interrupted``.
-    """
+    ``scene``). The keywords are described in docs/api.md. A stop signal (SIGINT, SIGTERM)
+    ends the run cleanly: ``result.summary.interrupted``."""
     items, saved = _checked(tick, speed, seed, perturb, disturb, save_at, resume)
     check_watching(record, video, rerun, viewer)  # before the script: usage comes first
     request = _dataset_request(dataset, fps, cameras)
     script = _script(script, scene)
-    from dial.engine import RunOptions
-    from dial.engine import run as run_engine
+    from dial import engine
 
     stops, console = _pausing(script, breaks, step, console)
     with log_sink(log) as sink, _recording(dataset, request, script, saved, perturb) as recorder:
-        options = RunOptions(
+        options = engine.RunOptions(
             tick=tick,
             speed=speed,
             seed=seed,
@@ -165,8 +164,30 @@ def run(
             console=console,
             save_at=None if save_at is None else (save_at[0], Path(save_at[1])),
             resume=saved,
+            follow_grasps=follow_grasps,
         )
-        return run_engine(script, options)
+        return engine.run(script, options)
+
+
+def world_file(path: str | Path) -> Path:
+    """``--save-world F.toml``'s check: a :class:`dial.OptionError` (the command line's usage
+    error) if F is not ``.toml`` or cannot be written, before anything runs."""
+    if Path(path).suffix.lower() != ".toml":
+        raise OptionError(f"--save-world writes a world file (.toml), not '{path}'")
+    try:
+        return writable(path, "the world file")
+    except DialError as e:
+        raise OptionError(f"--save-world: {e}") from None
+
+
+def save_world(result: RunResult, path: str | Path, made_by: str = "a run") -> None:
+    """Write what the world model believed at the end of ``result``'s run as a world file:
+    the run's own, its comments kept, each object's believed pose and size in ``[objects]``
+    (``dial run --save-world``; docs/teaching.md). ``made_by`` goes into its first line."""
+    from dial.teach.believed import save_world as write
+
+    note = f"The believed world at the end of {made_by}."
+    write(result.world, result.believed, world_file(path), note)
 
 
 def _checked(

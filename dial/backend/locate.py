@@ -60,6 +60,39 @@ def link_point(
     return np.array(contacts.pos[deepest], dtype=np.float64)
 
 
+def fingers_touching(
+    model: mujoco.MjModel, data: mujoco.MjData, body: str, fingers: tuple[int, ...]
+) -> int:
+    """How many of ``fingers`` have a link in contact with the body named ``body``."""
+    n = data.ncon
+    if n == 0:
+        return 0
+    target = int(mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, body))
+    b1 = model.geom_bodyid[data.contact.geom1[:n]]
+    b2 = model.geom_bodyid[data.contact.geom2[:n]]
+    other = np.concatenate([b2[b1 == target], b1[b2 == target]])
+    return sum(bool(np.isin(other, list(finger_bodies(model, f))).any()) for f in fingers)
+
+
+UPRIGHT = 0.7  # a contact normal within 45 deg of vertical: one body rests on the other
+
+
+def resting_on(model: mujoco.MjModel, data: mujoco.MjData, body: str) -> tuple[str, ...]:
+    """The names of the bodies that rest on the body named ``body``: in contact with it, above
+    it (the contact normal within 45 deg of vertical, pointing up into them)."""
+    n = data.ncon
+    if n == 0:
+        return ()
+    target = int(mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, body))
+    b1 = model.geom_bodyid[data.contact.geom1[:n]]
+    b2 = model.geom_bodyid[data.contact.geom2[:n]]
+    up = data.contact.frame[:n, 2]  # the normal's z, from geom1 to geom2
+    above = np.concatenate(
+        [b2[(b1 == target) & (up > UPRIGHT)], b1[(b2 == target) & (up < -UPRIGHT)]]
+    )
+    return tuple(model.body(int(b)).name for b in dict.fromkeys(above.tolist()))
+
+
 def _robot_root(model: mujoco.MjModel) -> int:
     """The root body of the robot's tree (the PUMA's base, which carries the hand)."""
     palm = int(mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, "hand_palm"))

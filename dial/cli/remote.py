@@ -114,7 +114,7 @@ def add_run_options(p: argparse.ArgumentParser) -> None:
         "the log adds link records (sent, acknowledged, reported, late, lost, diverged). "
         "The robot's world (--perturb, --seed, --disturb) is set at 'dial serve'; with "
         "--remote those, the debugging options, --realtime, --video, --viewer, "
-        "--log-states and --dataset are usage errors.",
+        "--log-states, --dataset and --save-world are usage errors.",
     )
     g.add_argument("--remote", metavar="URL", help="the robot's server, ws://HOST:PORT")
     g.add_argument(
@@ -204,6 +204,7 @@ def cmd_link(args: argparse.Namespace) -> int:
 WORLD = "the robot's world is perturbed and disturbed at 'dial serve'"
 PACED = "a remote run is paced by the robot: it does not pause, save or resume"
 SEEN = "the operator sees the robot in decimated telemetry: frames are a local run's"
+MODEL = "the world model that touch updates is the robot's"
 LOCAL_ONLY = (
     ("perturb", "--perturb", WORLD),
     ("seed", "--seed", WORLD),
@@ -217,6 +218,7 @@ LOCAL_ONLY = (
     ("viewer", "--viewer", SEEN),
     ("log_states", "--log-states", SEEN),
     ("dataset", "--dataset", SEEN),
+    ("save_world", "--save-world", MODEL),
 )
 
 

@@ -7,6 +7,7 @@ import json
 import sys
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 from dial.cli.common import (
@@ -64,6 +65,13 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         "[for=D]' (tactile, force or position reads as untouched); see docs/language.md",
     )
     p.add_argument("--log", metavar="FILE.jsonl", help="write the event log as JSON Lines")
+    p.add_argument(
+        "--save-world",
+        metavar="F.toml",
+        help="at the end, write the world file with every object where the world model "
+        "believes it (and its size, once measured), comments kept; 'dial world F.toml' "
+        "shows it and a script run in it starts from it",
+    )
     p.add_argument("--json", action="store_true", help="print a JSON summary as the last line")
     p.add_argument("--quiet", action="store_true", help="no progress and no summary table")
     p.add_argument("--realtime", action="store_true", help="pace the run to wall-clock time")
@@ -135,14 +143,19 @@ def cmd_run(args: argparse.Namespace) -> int:
 
 
 def _run(args: argparse.Namespace) -> int:
+    from dial import api  # the parser and the engine: not for --help
+
     if args.log_states and not args.log:
         raise UsageError("--log-states writes into the log: give --log FILE.jsonl too")
     save_at = _save_at(args.save_at)
+    world_file = None if args.save_world is None else api.world_file(args.save_world)
     folder, fps, cameras = dataset_request(args)
     with _dataset(folder, fps) as writer:
         result = _run_api(args, save_at, writer, cameras)
     if writer is not None and folder is not None:
         _said_written(writer, folder)
+    if world_file is not None:
+        api.save_world(result, world_file, f"`dial run {Path(args.script).name}`")
     return _report(args, result, save_at)
 
 

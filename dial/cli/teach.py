@@ -60,8 +60,16 @@ def add_parsers(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> Non
         "relative to an object), the programs and the success criteria. With --picture, "
         "also render the scene with every location drawn as a labelled frame.",
     )
-    p.add_argument("scene", metavar="SCENE", help="a bundled scene name or a world file path")
+    p.add_argument(
+        "scene", metavar="SCENE", nargs="?", help="a bundled scene name or a world file path"
+    )
     p.add_argument("--picture", metavar="FILE.png", help="draw the named frames over the scene")
+    p.add_argument(
+        "--believed",
+        metavar="LOG.jsonl",
+        help="instead of a scene: from a run's log, each object's believed pose (and size) "
+        "beside its true pose at the end of the run, and every change of the world model",
+    )
     p.set_defaults(func=cmd_world)
 
 
@@ -92,6 +100,17 @@ def cmd_teach(args: argparse.Namespace) -> int:
 
 
 def cmd_world(args: argparse.Namespace) -> int:
+    if args.believed is not None:
+        if args.scene is not None or args.picture:
+            raise UsageError(
+                "--believed LOG reads the scene from the log: give no SCENE or --picture"
+            )
+        from dial.teach.runlog import believed_from_log
+
+        sys.stdout.write(believed_from_log(Path(args.believed)))
+        return 0
+    if args.scene is None:
+        raise UsageError("give a SCENE (a bundled scene name or a world file), or --believed LOG")
     scene = _scene(args.scene, "SCENE")  # an argument here, not --scene
     if args.picture:
         if Path(args.picture).suffix.lower() != ".png":

@@ -11,6 +11,7 @@ from dial.cli.common import (
     at_least,
     dataset_arguments,
     dataset_request,
+    load_script,
     scene_argument,
     sigterm_as_interrupt,
 )
@@ -34,9 +35,9 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
     scene_argument(p)
     p.add_argument(
         "--ticks",
-        required=True,
         metavar="A:B:N",
-        help="N tick lengths from A to B s inclusive, linearly spaced (e.g. 0.05:0.5:10)",
+        help="N tick lengths from A to B s inclusive, linearly spaced (e.g. 0.05:0.5:10); "
+        "default: the script's own tick (@tick, else 0.25 s)",
     )
     p.add_argument("--trials", type=int, default=1, metavar="K", help="trials per tick length")
     p.add_argument(
@@ -80,6 +81,13 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
     p.set_defaults(func=cmd_tune)
 
 
+def _own_tick(script: str, scene: str | None) -> tuple[float]:
+    """Without ``--ticks``, the script's own tick (checked here, as the sweep would)."""
+    from dial.scheduler.types import DEFAULT_TICK
+
+    return (load_script(script, scene).tick or DEFAULT_TICK,)
+
+
 def cmd_tune(args: argparse.Namespace) -> int:
     from dial import api
     from dial.disturb import parse_disturbance
@@ -88,7 +96,7 @@ def cmd_tune(args: argparse.Namespace) -> int:
     from dial.tune import ProcessExecutor, TuneOptions, models, parse_ticks, tune
 
     try:
-        ticks = parse_ticks(args.ticks)
+        ticks = parse_ticks(args.ticks) if args.ticks is not None else ()
     except ValueError as e:
         raise UsageError(f"--ticks: {e}") from None
     at_least("--trials", args.trials, 1)
@@ -108,7 +116,7 @@ def cmd_tune(args: argparse.Namespace) -> int:
     options = TuneOptions(
         script=args.script,
         scene=scene,
-        ticks=ticks,
+        ticks=ticks or _own_tick(args.script, scene),
         trials=args.trials,
         perturb_mm=args.perturb,
         seed=args.seed,

@@ -43,7 +43,8 @@ class RunResult:
 
     ``ok``: the script ran to its end and every criterion held. ``summary``: the runner's
     figures (ticks, simulated time, outcome counts, the error or signal that stopped it).
-    ``results``: the fits by point-set name. ``log``: every record, in order.
+    ``results``: the fits by point-set name. ``log``: every record, in order. ``believed``:
+    what the world model believes of each object at the end (``dial run --save-world``).
     """
 
     summary: Tally
@@ -58,6 +59,8 @@ class RunResult:
     disturbances: tuple[str, ...] = ()
     saved: tuple[tuple[int, Path], ...] = ()  # (block number, state file) written
     unsaved: Path | None = None  # a paused run's 'save FILE' that no block came to write
+    # The world model at the end: body -> believed pos (m), rpy (deg), size (m) if known.
+    believed: dict[str, dict[str, object]] = field(default_factory=dict)
 
     @property
     def ok(self) -> bool:

@@ -18,6 +18,7 @@ import trio
 
 from dial.backend.driver import MujocoRobot
 from dial.disturb import Disturbance
+from dial.engine.beliefs import believed_world, journal
 from dial.engine.observe import Observer, StateLog, Watched, describe, fan_out, first_line
 from dial.engine.result import RunResult, measure_criteria
 from dial.engine.setup import Factory, prepare
@@ -29,7 +30,7 @@ from dial.primitives.context import Context
 from dial.robot.snapshot import Snapshot
 from dial.scheduler.log import EventLog
 from dial.scheduler.position import Resume
-from dial.scheduler.runner import Runner
+from dial.scheduler.runner import Runner, Tally
 from dial.scheduler.signals import StopRequest, catch_stop_signals
 from dial.scheduler.ticks import Progress, TickLoop
 from dial.scheduler.types import DEFAULT_TICK
@@ -62,6 +63,7 @@ class RunOptions:
     save_at: tuple[int, Path] | None = None  # (block number, state file)
     resume: StateFile | None = None  # a state file to go on from (its settings win)
     stop: StopRequest | None = None  # polled every period (a remote session's); else signals'
+    follow_grasps: bool = True  # grasped objects follow the hand in the world model
 
 
 def tick_length(script: Script, options: RunOptions) -> float:
@@ -91,7 +93,13 @@ def run(script: Script, options: RunOptions) -> RunResult:
         settings = _settings(script, options)
         drawn = bool(options.observers)  # an observer may draw: it gets the scene's textures
         robot, ctx = prepare(
-            script, log, settings.perturb_mm, settings.seed, settings.disturb, drawn
+            script,
+            log,
+            settings.perturb_mm,
+            settings.seed,
+            settings.disturb,
+            textures=drawn,
+            follow=options.follow_grasps,
         )
         resume = _resume(script, options.resume, robot, ctx, log)
         states = [StateLog(lanes=LanePlan.from_script(script))] if options.log_states else []
@@ -118,27 +126,42 @@ def run(script: Script, options: RunOptions) -> RunResult:
                 stop=stop,
                 hooks=hooks,
             )
+            ctx.world_model.journal = journal(log, runner)
             start, cpu = time.perf_counter(), time.process_time()
             summary = trio.run(runner.run, script, resume)
             wall, cpu = time.perf_counter() - start, time.process_time() - cpu
-            result = RunResult(
-                summary,
-                ctx.world,
-                measure_criteria(ctx.world, robot.model, robot.data, ctx.results),
-                dict(ctx.results),
-                wall,
-                cpu,
-                robot.steps,
-                log,
-                [float(x) for x in robot.data.qpos],
-                tuple(d.text for d in settings.disturb),
-                tuple(hooks.saved) if hooks is not None else (),
-                hooks.unsaved if hooks is not None else None,
-            )
+            result = _result(summary, robot, ctx, log, settings, hooks, (wall, cpu))
             log.write("summary", **result.as_record())
             return result
         finally:
             _end(begun, result)
+
+
+def _result(
+    summary: Tally,
+    robot: MujocoRobot,
+    ctx: Context,
+    log: EventLog,
+    settings: RunSettings,
+    hooks: Session | None,
+    times: tuple[float, float],
+) -> RunResult:
+    """The run's result, after the world model's closing ``world`` record."""
+    believed_world(log, ctx, robot, summary.ticks)
+    return RunResult(
+        summary,
+        ctx.world,
+        measure_criteria(ctx.world, robot.model, robot.data, ctx.results),
+        dict(ctx.results),
+        *times,
+        robot.steps,
+        log,
+        [float(x) for x in robot.data.qpos],
+        tuple(d.text for d in settings.disturb),
+        tuple(hooks.saved) if hooks is not None else (),
+        hooks.unsaved if hooks is not None else None,
+        {body: ctx.world_model.entry(body) for body in ctx.world.objects.values()},
+    )
 
 
 def _resume(

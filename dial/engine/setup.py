@@ -14,12 +14,14 @@ import numpy as np
 from dial.backend.disturb import Disturbances
 from dial.backend.driver import MujocoRobot
 from dial.backend.ik import ArmIK, FingerIK
+from dial.backend.locate import fingers_touching, resting_on
 from dial.backend.model import ARM_HOME, RobotIndex, hand_ctrl, load_model, scene_bodies
 from dial.disturb import Disturbance
 from dial.geometry import Pose, location_pose, rpy_matrix
 from dial.parser.script import Script
 from dial.primitives.context import Context
 from dial.robot.snapshot import Snapshot
+from dial.scene.belief import Beliefs, Feeling, initial
 from dial.scene.of_script import script_world
 from dial.scene.resolve import worlds_dir
 from dial.scene.thread import set_turns
@@ -62,11 +64,13 @@ def prepare(
     seed: int = 0,
     disturbances: Sequence[Disturbance] = (),
     textures: bool = True,
+    follow: bool = True,
 ) -> tuple[MujocoRobot, Context]:
     """Load the scene, place the robot at home, perturb, settle; log the ``scene`` record.
 
     ``textures=False``: compile the scene without its textures (a run that nothing draws;
-    the physics is the same to the bit, and the compile is a fifth of the time)."""
+    the physics is the same to the bit, and the compile is a fifth of the time).
+    ``follow=False``: grasped objects do not follow the hand in the world model."""
     world = script_world(script)
     model = load_model(world.model_path, textures=textures)
     set_turns(model, world)
@@ -74,10 +78,11 @@ def prepare(
     index = RobotIndex.from_model(model)
     unmoved = mujoco.MjData(model)
     mujoco.mj_forward(model, unmoved)
-    believed: dict[str, Pose] = {
+    at_load: dict[str, Pose] = {
         model.body(b).name: (unmoved.xpos[b].copy(), unmoved.xmat[b].reshape(3, 3).copy())
         for b in scene_bodies(model, world)
     }
+    believed, sizes = initial(world, at_load)
     shift = perturb(model, world, perturb_mm, seed)
     data = mujoco.MjData(model)
     ik = ArmIK()
@@ -98,18 +103,35 @@ def prepare(
     where = world.path.name if bundled else str(world.path)
     log.write("scene", scene=world.name, world=where, perturb=shift, seed=seed)
     robot = MujocoRobot(model, data, disturbances=placed)
-    return robot, Context(robot, robot.view, world, believed, ik, FingerIK(ik.model))
+    beliefs = Beliefs(world, believed, sizes, follow=follow, feeling=feeling(robot))
+    ctx = Context(robot, robot.view, world, believed, ik, FingerIK(ik.model), beliefs=beliefs)
+    return robot, ctx
+
+
+def feeling(robot: MujocoRobot) -> Feeling:
+    """What the world model asks of the physics: which fingers touch an object, what rests
+    on one (:mod:`dial.backend.locate`), and the time."""
+    m, d = robot.model, robot.data
+    return Feeling(
+        lambda body, fingers: fingers_touching(m, d, body, fingers),
+        lambda body: resting_on(m, d, body),
+        lambda: robot.time,
+    )
 
 
 class Factory:
     """The runner's primitive factory on a robot: each run's primitive or sensor, as its
-    event's record declares it (``Args.primitive``, ``Args.sensor``)."""
+    event's record declares it (``Args.primitive``, ``Args.sensor``). Before each, the world
+    model carries what the hand holds to where the tool is, and lets go of what the fingers
+    no longer touch (nothing to do while nothing is held)."""
 
     def __init__(self, ctx: Context) -> None:
         self.ctx = ctx
 
     def primitive(self, info: RunInfo) -> Primitive[Snapshot]:
+        self.ctx.refresh()
         return info.event.args.primitive(self.ctx, info.allotment)
 
     def sensor(self, info: RunInfo) -> Sensor[Snapshot]:
+        self.ctx.refresh()
         return info.event.args.sensor(self.ctx)

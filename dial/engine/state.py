@@ -31,6 +31,7 @@ from dial.errors import DialError
 from dial.parser.script import Script, Step, TBlock, TCall, TIf, TRepeat, scripts_of
 from dial.primitives.context import Context
 from dial.robot.snapshot import Touch
+from dial.scene.belief import Held
 from dial.scheduler.position import Frame, Resume, TimelinePath
 from dial.scheduler.primitive import Outcome
 from dial.scheduler.ticks import TickLoop
@@ -182,7 +183,7 @@ def save(
         "contacts": ctx.point_sets,
         "stops": {str(f): [_point(c.tactile), _point(c.link)] for f, c in ctx.stops.items()},
         "results": ctx.results,
-        "believed": {body: _array(pos) for body, (pos, _) in ctx.believed.items()},
+        **_beliefs(ctx),
         "robot": {
             "steps": robot.steps,
             "arm_target": _array(robot.arm_target),
@@ -299,9 +300,50 @@ class StateFile:
         for f, (tactile, link) in d.get("stops", {}).items():
             ctx.stops[int(f)] = Touch(_stop_point(tactile), _stop_point(link))
         ctx.results.update(d["results"])
-        for body, pos in d.get("believed", {}).items():  # as `locate` left them
-            if body in ctx.believed:
-                ctx.believed[body] = (_floats(pos, 3, f"believed {body}"), ctx.believed[body][1])
+        _restore_beliefs(d, ctx)
+
+
+def _beliefs(ctx: Context) -> dict[str, Any]:
+    """The world model's part of a state file: believed poses and sizes, what is held."""
+    held = {
+        body: {
+            "fingers": list(h.fingers),
+            "relative": [_array(h.relative[0]), _array(h.relative[1])],
+            "grasped": [_array(h.grasped[0]), _array(h.grasped[1])],
+            "on": h.on,
+        }
+        for body, h in ctx.world_model.held.items()
+    }
+    return {
+        "believed": {body: _array(pos) for body, (pos, _) in ctx.believed.items()},
+        "believed_rot": {body: _array(rot) for body, (_, rot) in ctx.believed.items()},
+        "sizes": {body: _array(size) for body, size in ctx.world_model.sizes.items()},
+        "learned": ctx.world_model.changed,
+        "held": held,
+    }
+
+
+def _restore_beliefs(d: dict[str, Any], ctx: Context) -> None:
+    """The world model as the run left it: believed poses and sizes, what the hand holds."""
+    rots = d.get("believed_rot", {})
+    for body, pos in d.get("believed", {}).items():
+        if body in ctx.believed:
+            rot = ctx.believed[body][1]
+            if body in rots:
+                rot = _floats(rots[body], 9, f"believed {body}").reshape(3, 3)
+            ctx.believed[body] = (_floats(pos, 3, f"believed {body}"), rot)
+    model = ctx.world_model
+    model.changed = bool(d.get("learned", False))
+    for body, size in d.get("sizes", {}).items():
+        model.sizes[body] = _floats(size, 3, f"size of {body}")
+    for body, held in d.get("held", {}).items():
+        relative, grasped = (
+            (_floats(p, 3, body), _floats(r, 9, body).reshape(3, 3)) for p, r in (
+                held["relative"], held["grasped"]
+            )
+        )  # fmt: skip
+        fingers = tuple(int(f) for f in held["fingers"])
+        model.held[body] = Held(fingers, relative, grasped, str(held.get("on", "")))
 
 
 def load(source: Path) -> StateFile:

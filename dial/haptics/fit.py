@@ -16,6 +16,8 @@ import numpy.typing as npt
 from scipy.optimize import least_squares
 from scipy.spatial.transform import Rotation
 
+from dial.haptics.lines import trace_angle
+
 Array = npt.NDArray[np.float64]
 
 # Degeneracy tests on the singular values s0 >= s1 >= s2 of the centred points.
@@ -51,13 +53,16 @@ class PlaneFit:
     ``normal`` (3,) is a unit vector in the hemisphere of the ``up`` vector given to
     :func:`fit_plane`. ``axes`` (2, 3) holds the in-plane principal directions as rows, the
     direction of largest spread first, with ``axes[0] x axes[1] = normal``. ``extents`` (2,)
-    is max - min of the points projected on each axis. Residuals are distances off the plane.
+    is max - min of the points projected on each axis, and ``centre`` (3,) the point of the
+    plane halfway between those extremes: the middle of a traced face. Residuals are distances
+    off the plane.
     """
 
     centroid: Array
     normal: Array
     axes: Array
     extents: Array
+    centre: Array
     rms_residual: float
     max_residual: float
     count: int
@@ -68,6 +73,7 @@ class PlaneFit:
             "normal": _floats(self.normal),
             "extents": _floats(self.extents),
             "centroid": _floats(self.centroid),
+            "centre": _floats(self.centre),
             "axes": [_floats(a) for a in self.axes],
             "rms_residual": self.rms_residual,
             "max_residual": self.max_residual,
@@ -129,8 +135,7 @@ def fit_plane(points: npt.ArrayLike, up: npt.ArrayLike = (0.0, 0.0, 1.0)) -> Pla
             f"({_rms_mm(s[2], len(p))} rms)"
         )
     normal = vt[2] if vt[2] @ up_vec >= 0.0 else -vt[2]
-    first = _sign_fixed(vt[0])
-    axes = np.stack([first, np.cross(normal, first)])
+    axes = _plane_axes(centred, normal, vt[0])
     along = centred @ axes.T
     off = centred @ normal
     return PlaneFit(
@@ -138,10 +143,27 @@ def fit_plane(points: npt.ArrayLike, up: npt.ArrayLike = (0.0, 0.0, 1.0)) -> Pla
         normal=_frozen(normal),
         axes=_frozen(axes),
         extents=_frozen(along.max(axis=0) - along.min(axis=0)),
+        centre=_frozen(centroid + axes.T @ ((along.max(axis=0) + along.min(axis=0)) / 2.0)),
         rms_residual=float(np.sqrt(np.mean(off**2))),
         max_residual=float(np.max(np.abs(off))),
         count=len(p),
     )
+
+
+def _plane_axes(centred: Array, normal: Array, principal: Array) -> Array:
+    """The in-plane axes (2, 3): the traces' directions when the points lie on straight
+    traces (:func:`dial.haptics.lines.trace_angle`), else the principal ones; the axis of
+    the larger extent first, its largest component positive, ``axes[0] x axes[1] = normal``."""
+    first = _sign_fixed(principal)
+    axes = np.stack([first, np.cross(normal, first)])
+    angle = trace_angle(centred @ axes.T)
+    if angle is None:
+        return axes
+    turned = np.cos(angle) * axes[0] + np.sin(angle) * axes[1]
+    pair = np.stack([turned, np.cross(normal, turned)])
+    spread = np.ptp(centred @ pair.T, axis=0)
+    first = _sign_fixed(pair[0] if spread[0] >= spread[1] else pair[1])
+    return np.stack([first, np.cross(normal, first)])
 
 
 def fit_superquadric(

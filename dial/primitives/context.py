@@ -14,6 +14,7 @@ from dial.robot.protocol import ArmKinematics, Commanded, FingerKinematics
 from dial.robot.slots import Slots
 from dial.robot.snapshot import Snapshot, Touch
 from dial.robot.view import RobotView
+from dial.scene.belief import Beliefs
 from dial.scene.world import World
 from dial.scheduler.primitive import Allotment, Ended, Outcome, Primitive
 
@@ -25,7 +26,9 @@ class Context:
     ``robot``: what their slots write (set-points, limp joints, guards); ``view``: what the
     robot is (joint ranges, fingers). ``believed`` holds each object's pose as the world
     model believes it (position (3,), rotation (3, 3)); with ``--perturb`` the true pose in
-    the physics differs, and only sensing can make up the difference.
+    the physics differs, and only sensing can make up the difference. ``beliefs`` is the
+    world model around it (sizes, held objects, the log of its changes:
+    :mod:`dial.scene.belief`); the engine gives it what the fingers touch.
     """
 
     robot: Commanded
@@ -38,9 +41,32 @@ class Context:
     # finger -> where it touched when the latest guarded move sensing it stopped on contact
     stops: dict[int, Touch] = field(default_factory=dict)
     results: dict[str, dict[str, object]] = field(default_factory=dict)
+    beliefs: Beliefs | None = None  # made from world and believed when not given
+
+    def __post_init__(self) -> None:
+        if self.beliefs is None:
+            self.beliefs = Beliefs(self.world, self.believed)
+
+    @property
+    def world_model(self) -> Beliefs:
+        """The world model (``beliefs``, always set after construction)."""
+        assert self.beliefs is not None
+        return self.beliefs
 
     def location(self, name: str) -> Pose:
+        """A location's tool pose, relative objects where the world model believes them now
+        (a held one where the tool has carried it)."""
+        self.refresh()
         return location_pose(self.world, self.believed, name)
+
+    def tool(self) -> Pose:
+        """The commanded tool pose: where the planner starts the next motion from."""
+        return self.arm_ik.fk(self.robot.arm_target)
+
+    def refresh(self) -> None:
+        """Carry the held objects to where the tool is, releasing those let go of."""
+        if self.world_model.held:
+            self.world_model.update(self.tool())
 
 
 class RobotPrimitive(Primitive[Snapshot]):

@@ -90,6 +90,7 @@ class GraspForce(RobotPrimitive):
         self.target[:] = q
         self.slots.joints(self.jmask, self.target)
         if self.monitored <= stopped.keys():
+            self.ctx.world_model.grasp(self.ctx.tool(), tuple(self.fingers))
             return done(forces=self._forces(diff))
         if all(q[k] >= limits[k] for k in closing) and not (self.monitored & stopped.keys()):
             message = "the fingers closed fully without reaching the force"

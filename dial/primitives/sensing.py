@@ -126,21 +126,32 @@ class Locate:
         tool, _ = self.ctx.arm_ik.fk(snapshot.arm_target)
         shift = tool - self.ctx.location(self.location)[0]
         aliases = {b: a for a, b in world.objects.items()}
-        bodies = dict.fromkeys([body, *(world.objects[a] for a in self.also)])
-        for b in bodies:
-            pos, rot = self.ctx.believed[b]
-            self.ctx.believed[b] = (pos + shift, rot)
+        bodies = tuple(dict.fromkeys([body, *(world.objects[a] for a in self.also)]))
+        self.ctx.world_model.locate(bodies, shift, snapshot.time, self.location_object())
         return done(shift=shift, objects=[aliases.get(b, b) for b in bodies])
+
+    def location_object(self) -> str:
+        """The alias the location is written relative to."""
+        return next(
+            (a for a, b in self.ctx.world.objects.items()
+             if b == self.ctx.world.locations[self.location].body),
+            "",
+        )  # fmt: skip
 
 
 class Fit:
     """``fit_plane SET`` and ``fit_superquadric SET``: ``fit`` (least squares) over a point
-    set."""
+    set; with ``learns`` (an object's alias), the world model takes the fit as that object's
+    position and size (:mod:`dial.scene.belief`)."""
 
     def __init__(
-        self, ctx: Context, point_set: str, fit: Callable[[FloatArray], PlaneFit | SuperquadricFit]
+        self,
+        ctx: Context,
+        point_set: str,
+        fit: Callable[[FloatArray], PlaneFit | SuperquadricFit],
+        learns: str | None = None,
     ) -> None:
-        self.ctx, self.set, self.fit = ctx, point_set, fit
+        self.ctx, self.set, self.fit, self.object = ctx, point_set, fit, learns
 
     def sense(self, snapshot: Snapshot) -> Ended:
         from dial.haptics import FitError  # SciPy: only a run that fits loads it
@@ -152,4 +163,11 @@ class Fit:
             return Ended(Outcome.MISSED, f"point set '{self.set}': {e}")
         result = fit.as_result()
         self.ctx.results[self.set] = result
+        if self.object is not None:  # the object measured: the world model learns it
+            body, model = self.ctx.world.objects[self.object], self.ctx.world_model
+            self.ctx.refresh()
+            if isinstance(fit, PlaneFit):
+                model.learn_plane(body, result, snapshot.time, self.object)
+            else:
+                model.learn_superquadric(body, result, points, snapshot.time, self.object)
         return done(set=self.set, points=len(points), **result)

@@ -36,6 +36,8 @@ FIELDS: dict[str, dict[str, type | tuple[type, ...]]] = {
     "error": {"message": str, "tick": int, "t": _NUM},
     "interrupted": {"tick": int, "t": _NUM},
     "state": {"tick": int, "t": _NUM, "qpos": list, "tension": list},
+    "belief": {"object": str, "why": str, "before": dict, "after": dict, "t": _NUM},
+    "world": {"objects": dict, "t": _NUM},
     "summary": {"sim_time": _NUM, "success": dict, "criteria": dict},
 }
 
@@ -145,6 +147,8 @@ def describe(record: LogRecord) -> tuple[str, str] | None:
         )
     if kind == "thread":
         return f"thread {record['name']} released", "info"
+    if kind == "belief":
+        return _belief(record), "info"
     if kind == "monitor":
         return f"monitor '@on {record['condition']}' (line {record['line']}) fired", "warn"
     if kind == "disturb":
@@ -165,6 +169,15 @@ def describe(record: LogRecord) -> tuple[str, str] | None:
         verdict = "OK" if record.get("ok") else "FAILED"
         return f"{verdict} {marks}".rstrip(), "info" if record.get("ok") else "error"
     return None
+
+
+def _belief(record: LogRecord) -> str:
+    """A ``belief`` record: which object the world model changed, why, and how far it moved."""
+    before, after = record["before"].get("pos"), record["after"].get("pos")
+    moved = ""
+    if isinstance(before, list) and isinstance(after, list) and len(before) == len(after):
+        moved = f", moved {1000.0 * math.dist(before, after):.1f} mm"
+    return f"world model: {record['object']} {record['why']}{moved}"
 
 
 def timeline(records: Iterable[LogRecord]) -> str:

@@ -9,7 +9,7 @@ from __future__ import annotations
 import math
 import tomllib
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from difflib import get_close_matches
 from pathlib import Path
 from types import MappingProxyType
@@ -20,6 +20,7 @@ from dial.instructions.scene_names import SceneNames
 from dial.instructions.types import FINGERS
 from dial.scene.criteria import Criterion, parse_criterion
 from dial.scene.mjcf import body_names
+from dial.scene.objects import Prior, parse_objects
 from dial.scene.reader import Reader, WorldFileError
 from dial.scene.resolve import resolve_scene
 from dial.scene.valii import NAME, Appro, Drive, Move, Statement, StatementError, parse_statement
@@ -81,7 +82,8 @@ class Program:
 
 @dataclass(frozen=True)
 class World:
-    """Everything a world file declares. ``objects`` maps aliases to MuJoCo body names."""
+    """Everything a world file declares. ``objects`` maps aliases to MuJoCo body names;
+    ``priors`` maps body names to what the file says is believed of them (if anything)."""
 
     name: str
     path: Path
@@ -92,6 +94,7 @@ class World:
     programs: Mapping[str, Program]
     criteria: tuple[Criterion, ...]
     thread_turns: float | None = None  # [thread] turns: the model's threads let go after these
+    priors: Mapping[str, Prior] = field(default_factory=lambda: MappingProxyType({}))
 
     def scene_names(self) -> SceneNames:
         """The names the script checker needs."""
@@ -119,7 +122,7 @@ def load_world(path: Path) -> World:
     model_path = Path(reader.string(scene["model"], "scene.model"))
     if not model_path.is_file():
         raise reader.error("scene.model", f"no such model file: {model_path}")
-    objects = _objects(reader, data["objects"])
+    objects, priors = parse_objects(reader, data["objects"])
     poses: dict[str, HandPose] = {}
     if "poses" in scene:
         shared = Path(reader.string(scene["poses"], "scene.poses"))
@@ -150,6 +153,7 @@ def load_world(path: Path) -> World:
         programs=MappingProxyType(programs),
         criteria=criteria,
         thread_turns=_thread_turns(reader, data["thread"]) if "thread" in data else None,
+        priors=MappingProxyType(priors),
     )
 
 
@@ -205,16 +209,6 @@ def _shared_poses(world: Reader, path: Path) -> dict[str, HandPose]:
     reader = Reader(path)
     reader.keys(data, "", ["poses"], [])
     return {n: parse_pose(reader, n, t) for n, t in reader.table(data["poses"], "poses").items()}
-
-
-def _objects(reader: Reader, value: Any) -> dict[str, str]:
-    table = reader.table(value, "objects")
-    if not table:
-        raise reader.error("objects", 'declare at least one object (alias = "body_name")')
-    return {
-        _name(reader, "objects", alias): reader.string(body, f"objects.{alias}")
-        for alias, body in table.items()
-    }
 
 
 def _location(reader: Reader, name: str, value: Any, objects: Mapping[str, str]) -> Location:

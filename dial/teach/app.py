@@ -89,4 +89,4 @@ def world(scene: str, picture: Path | None = None) -> tuple[str, int]:
         from dial.teach.pictures import world_picture
 
         drawn = world_picture(sim, picture)
-    return describe(world, sim.ctx.believed), drawn
+    return describe(world, sim.ctx.believed, sim.ctx.world_model.sizes), drawn

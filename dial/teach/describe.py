@@ -22,7 +22,7 @@ from dial.teach.frames import deg_text, matrix_rpy, mm_text
 Believed = Mapping[str, tuple[FloatArray, FloatArray]]
 
 
-def _columns(rows: list[list[str]], indent: str = "  ") -> list[str]:
+def columns(rows: list[list[str]], indent: str = "  ") -> list[str]:
     """Rows of cells, each column padded to its widest cell (the last one is not padded)."""
     if not rows:
         return [f"{indent}(none)"]
@@ -77,22 +77,29 @@ def criterion_text(criterion: Criterion) -> str:
     return " ".join(parts)
 
 
-def describe(world: World, believed: Believed) -> str:
-    """Every name of ``world``; ``believed`` maps each object's body to its pose at load."""
+def describe(
+    world: World, believed: Believed, sizes: Mapping[str, FloatArray] | None = None
+) -> str:
+    """Every name of ``world``; ``believed`` maps each object's body to its pose at load, and
+    ``sizes`` to its believed half-sizes where known (a world file saved by ``dial run
+    --save-world``)."""
     lines = [f"scene {world.name}: {world.path}", f"model {world.model_path.name}"]
     if world.thread_turns is not None:
         lines.append(f"thread {world.thread_turns:g} turns until it lets go")
     lines.append("")
-    lines.append("objects (believed pose at load: pos mm, rpy deg)")
+    sized = {b: v for b, v in (sizes or {}).items() if b in world.objects.values()}
+    size_note = "; size: half-sizes mm" if sized else ""
+    lines.append(f"objects (believed pose at load: pos mm, rpy deg{size_note})")
     rows = []
     for alias, body in world.objects.items():
         pos, rot = believed[body]
-        rows.append([alias, body, f"pos {mm_text(pos)}", f"rpy {deg_text(matrix_rpy(rot))}"])
-    lines += _columns(rows)
+        row = [alias, body, f"pos {mm_text(pos)}", f"rpy {deg_text(matrix_rpy(rot))}"]
+        if body in sized:
+            row.append(f"size {mm_text(sized[body])}")
+        rows.append(row)
+    lines += columns(rows)
     lines += ["", "poses (deg: [abd, mcp, pip, dip], or the joints set)"]
-    lines += _columns(
-        [[n, f"0x{p.mask:04X}", pose_text(p)] for n, p in sorted(world.poses.items())]
-    )
+    lines += columns([[n, f"0x{p.mask:04X}", pose_text(p)] for n, p in sorted(world.poses.items())])
     lines += ["", "locations (tool frame: pos mm, rpy deg; in the world, then as defined)"]
     rows = []
     for name, loc in world.locations.items():
@@ -104,11 +111,11 @@ def describe(world: World, believed: Believed) -> str:
             rpy = [math.degrees(a) for a in loc.rpy]
             defined = f"relative to {alias}{axes}: pos {mm_text(loc.pos)} rpy {deg_text(rpy)}"
         rows.append([name, f"pos {mm_text(pos)}", f"rpy {deg_text(matrix_rpy(rot))}", defined])
-    lines += _columns(rows)
+    lines += columns(rows)
     lines += ["", "programs"]
-    lines += _columns(
+    lines += columns(
         [[n, "; ".join(statement_text(s) for s in p.statements)] for n, p in world.programs.items()]
     )
     lines += ["", "success criteria"]
-    lines += _columns([[c.name, c.kind, criterion_text(c)] for c in world.criteria])
+    lines += columns([[c.name, c.kind, criterion_text(c)] for c in world.criteria])
     return "\n".join(lines) + "\n"

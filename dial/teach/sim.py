@@ -22,6 +22,7 @@ from dial.geometry import location_pose, rpy_matrix, smooth
 from dial.primitives.arm import Segment
 from dial.primitives.context import Context
 from dial.robot.snapshot import FloatArray
+from dial.scene.belief import Beliefs, initial
 from dial.scene.thread import find_threads, set_turns
 from dial.scene.world import World
 from dial.teach.contacts import Parts, collision
@@ -61,12 +62,13 @@ class State:
 def believed_poses(
     model: mujoco.MjModel, data: mujoco.MjData, world: World
 ) -> dict[str, tuple[FloatArray, FloatArray]]:
-    """Each world object's pose in ``data`` (body name -> position (3,), rotation (3, 3))."""
+    """Each world object's believed pose (body name -> position (3,), rotation (3, 3)): where
+    ``data`` has it, unless the world file says otherwise (:func:`dial.scene.belief.initial`)."""
     out = {}
     for body in world.objects.values():
         b = model.body(body).id
         out[body] = (data.xpos[b].copy(), data.xmat[b].reshape(3, 3).copy())
-    return out
+    return initial(world, out)[0]
 
 
 def home_pose(world: World, believed: dict[str, tuple[FloatArray, FloatArray]]) -> Pose3:
@@ -102,7 +104,8 @@ class Sim:
         mujoco.mj_forward(model, data)
         # The planner of `dial run` reads the world, the IK and the joint ranges from here.
         robot = MujocoRobot(model, data)
-        self.ctx = Context(robot, robot.view, world, believed, self.ik, FingerIK())
+        beliefs = Beliefs(world, believed, initial(world, believed)[1])
+        self.ctx = Context(robot, robot.view, world, believed, self.ik, FingerIK(), beliefs=beliefs)
         self.arm_range = robot.view.arm_range  # (6, 2) rad
         self.hand_range = robot.view.hand_range  # (16, 2) rad, mask order
         if settle:

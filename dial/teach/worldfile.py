@@ -52,7 +52,7 @@ class Taught:
     def text(self) -> str:
         """The entry as it appears in the file."""
         if self.table == "locations":
-            return f"{self.name} = {_inline(self.items)}"
+            return f"{self.name} = {inline_table(self.items)}"
         body = "".join(f"{k} = {v}\n" for k, v in self.items)
         return f"[poses.{self.name}]\n{body}"
 
@@ -63,11 +63,11 @@ def number(value: float, digits: int) -> str:
     return str(int(x)) if x == int(x) else f"{x:.{digits}f}".rstrip("0")
 
 
-def _vector(values: Iterable[float], digits: int) -> str:
+def toml_vector(values: Iterable[float], digits: int) -> str:
     return "[" + ", ".join(number(v, digits) for v in values) + "]"
 
 
-def _inline(items: Iterable[tuple[str, str]]) -> str:
+def inline_table(items: Iterable[tuple[str, str]]) -> str:
     return "{ " + ", ".join(f"{k} = {v}" for k, v in items) + " }"
 
 
@@ -83,7 +83,7 @@ def location_entry(
     p = tuple(round(v, POS_DIGITS) for v in pos)
     r = tuple(half_turn(round(v, ANGLE_DIGITS)) for v in rpy_deg)
     items = [] if alias is None else [("object", f'"{alias}"')]
-    items += [("pos", _vector(p, POS_DIGITS)), ("rpy", _vector(r, ANGLE_DIGITS))]
+    items += [("pos", toml_vector(p, POS_DIGITS)), ("rpy", toml_vector(r, ANGLE_DIGITS))]
     if world_axes:
         items.append(("axes", '"world"'))
     rad = (math.radians(r[0]), math.radians(r[1]), math.radians(r[2]))
@@ -98,9 +98,11 @@ def pose_entry(name: str, angles_deg: dict[int, float]) -> tuple[HandPose, Taugh
     for f, finger in enumerate(FINGERS):
         joints = [(j, rounded[4 * f + j]) for j in range(4) if 4 * f + j in rounded]
         if len(joints) == 4:
-            items.append((finger, _vector((a for _, a in joints), ANGLE_DIGITS)))
+            items.append((finger, toml_vector((a for _, a in joints), ANGLE_DIGITS)))
         elif joints:
-            items.append((finger, _inline((JOINTS[j], number(a, ANGLE_DIGITS)) for j, a in joints)))
+            items.append(
+                (finger, inline_table((JOINTS[j], number(a, ANGLE_DIGITS)) for j, a in joints))
+            )
     pose = HandPose(name, {bit: math.radians(a) for bit, a in rounded.items()})
     return pose, Taught("poses", name, tuple(items))
 
@@ -114,7 +116,7 @@ def new_file_text(extends: str, scene: str, into: str) -> str:
     )
 
 
-def _value(text: str) -> Item:
+def toml_item(text: str) -> Item:
     item = tomlkit.parse(f"v = {text}\n").item("v")  # keeps the layout of ``text``
     assert isinstance(item, Item)
     return item
@@ -133,7 +135,7 @@ def _put_location(doc: tomlkit.TOMLDocument, entry: Taught) -> None:
         table = tomlkit.table()
         _blank_line(doc)
         doc.add("locations", table)
-    table[entry.name] = _value(_inline(entry.items))
+    table[entry.name] = toml_item(inline_table(entry.items))
 
 
 def _put_pose(doc: tomlkit.TOMLDocument, entry: Taught) -> None:
@@ -147,11 +149,11 @@ def _put_pose(doc: tomlkit.TOMLDocument, entry: Taught) -> None:
         for finger in [k for k in existing if k not in dict(entry.items)]:
             del existing[finger]
         for key, text in entry.items:
-            existing[key] = _value(text)
+            existing[key] = toml_item(text)
         return
     table = tomlkit.table()
     for key, text in entry.items:
-        table.add(key, _value(text))
+        table.add(key, toml_item(text))
     table.add(tomlkit.nl())
     poses[entry.name] = table
 

@@ -23,6 +23,9 @@ TOL = 0.001  # m: a contact point lies within half the penetration of the surfac
 
 WORLD = """\
 extends = "containment"
+[locations]
+# 10 cm above side_180
+over_180 = { object = "target", pos = [-0.0257, 0, 0.2125], rpy = [167, 0, 90], axes = "world" }
 [programs]
 to_face = \"\"\"
 MOVE over_180

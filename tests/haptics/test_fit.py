@@ -63,6 +63,49 @@ def test_plane_of_a_traced_rectangle() -> None:
     assert fit.count == len(p)
 
 
+def _lopsided_cross(rng: np.random.Generator, turn_deg: float) -> Array:
+    """The cross explore_surface.dial traced on the 0.20 x 0.14 m face with the block 20 mm
+    from where it was believed (trial 1 of seed 41): the first trace the full length, 28 mm in
+    from the south edge, every 10 mm; the across trace 20 mm west of the centre, from the
+    first to the south edge and, from the north side, its last 30 mm, every 5 mm (the middle
+    is not traced); each trace 1 deg off its course; turned in-plane by ``turn_deg``."""
+    x = np.arange(-0.10, 0.1001, 0.01)
+    across = np.concatenate([np.arange(-0.05, -0.0701, -0.005), np.arange(0.04, 0.0701, 0.005)])
+    drift = math.tan(math.radians(1.0))
+    pts = [np.stack([x, -0.042 + drift * x, 0 * x], axis=1)]
+    pts += [np.stack([-0.02 - drift * across, across, 0 * across], axis=1)]
+    flat = np.concatenate(pts)
+    flat += rng.normal(scale=PLANE_NOISE, size=flat.shape)
+    return flat @ Rotation.from_euler("z", turn_deg, degrees=True).as_matrix().T
+
+
+@pytest.mark.parametrize("turn_deg", [0.0, 30.0, -60.0])
+def test_plane_axes_follow_a_lopsided_cross_of_traces(turn_deg: float) -> None:
+    """The principal directions of this cross are 15 deg off its traces, which would make
+    both extents 5-15 mm short; the traces' own directions give them to within 1 mm."""
+    points = _lopsided_cross(np.random.default_rng(5), turn_deg)
+    centred = points - points.mean(axis=0)
+    principal = np.linalg.svd(centred, full_matrices=False)[2][0]
+    trace = Rotation.from_euler("z", turn_deg + 1.0, degrees=True).apply([1.0, 0.0, 0.0])
+    assert _angle_deg(principal, trace) > 10.0  # the case the trace lines are for
+    fit = fit_plane(points)
+    assert _angle_deg(fit.axes[0], trace) < 0.5  # the traces are 1 deg off their course
+    assert np.allclose(fit.extents, [0.20, 0.14], atol=0.001)
+    assert np.allclose(np.cross(fit.axes[0], fit.axes[1]), fit.normal)
+
+
+def test_scattered_points_keep_the_principal_axes() -> None:
+    """Points that are not straight traces (here a uniform scatter on a 0.12 x 0.04 m patch,
+    turned 20 deg) give the principal directions."""
+    rng = np.random.default_rng(6)
+    flat = rng.uniform(-0.5, 0.5, (60, 3)) * np.array([0.12, 0.04, 0.0])
+    points = flat @ Rotation.from_euler("z", 20.0, degrees=True).as_matrix().T
+    fit = fit_plane(points)
+    centred = points - points.mean(axis=0)
+    principal = np.linalg.svd(centred, full_matrices=False)[2][0]
+    assert _angle_deg(fit.axes[0], principal) < 1e-6
+
+
 @pytest.mark.parametrize(
     "rotvec_deg", [(30.0, 0.0, 0.0), (0.0, -75.0, 20.0), (90.0, 0.0, 0.0), (140.0, 40.0, 10.0)]
 )

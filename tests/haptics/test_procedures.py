@@ -29,7 +29,7 @@ def _run(
         cwd=ROOT,
         capture_output=True,
         text=True,
-        timeout=120,
+        timeout=300,
     )
     summary = json.loads(proc.stdout.strip().splitlines()[-1])
     records = [json.loads(line) for line in log.read_text().splitlines()]

@@ -27,9 +27,9 @@ def _tick(k: int, t0: float, t1: float, block_tick: int, stretch: int = 0) -> di
 def test_the_plan_orders_lanes_as_the_script_and_groups_a_callee() -> None:
     script = load(resolve_script("explore.dial"), loader=load_scene_names)
     plan = LanePlan.from_script(script)
-    assert plan.order[:8] == (
-        ("reach",), ("point",), ("find",), ("give_up",), ("lift",), ("aside",), ("wide",),
-        ("clear",),
+    assert plan.order[:9] == (
+        ("reach",), ("point",), ("find",), ("again",), ("give_up",), ("lift",), ("aside",),
+        ("wide",), ("clear",),
     )  # fmt: skip
     callees = [k for k in plan.order if len(k) == 2]
     # containment calls two scripts of its own: a lane group each, in the order first met.
@@ -37,12 +37,12 @@ def test_the_plan_orders_lanes_as_the_script_and_groups_a_callee() -> None:
         "explore_surface", "containment", "containment_top", "containment_side"
     ]  # fmt: skip
     assert (
-        plan.holds[("", 30, 1)] == 2 and plan.holds[("", 31, 1)] == 4
+        plan.holds[("", 32, 1)] == 2 and plan.holds[("", 33, 1)] == 4
     )  # reach #===--, point #----
     lanes = Lanes(plan)
     assert lanes.path(("reach",)) == ("01_reach",)
-    assert lanes.path(("explore_surface", "reach")) == ("09_explore_surface", "01_reach")
-    assert lanes.path(("containment", "reach_top")) == ("10_containment", "01_reach_top")
+    assert lanes.path(("explore_surface", "reach")) == ("10_explore_surface", "01_reach")
+    assert lanes.path(("containment", "reach_top")) == ("11_containment", "01_reach_top")
     assert LanePlan.from_record(json.loads(json.dumps(plan.as_record()))) == plan
 
 

@@ -257,9 +257,10 @@ def test_extends_a_bundled_scene_by_name_and_detects_cycles(tmp_path: Path) -> N
     )
     world = load_world(mine)
     assert world.name == "mine" and world.locations["side_135"].body == "containment_rounded"
-    programs = {"to_top", "down_top", "to_sides", "down_sides", "retract_arm"}
+    programs = {"to_top", "down_top", "to_sides", "down_sides", "to_top_again", "leave_top"}
     programs |= {f"to_top_{side}" for side in ("east", "west", "north", "south")}
-    programs |= {f"next_{azimuth}" for azimuth in (225, 270, 315, 0, 45, 90, 135)}
+    programs |= {f"next_{azimuth}" for azimuth in (270, 0, 90, 135)}
+    programs |= {f"back_{azimuth}" for azimuth in (45, 315, 225)}
     assert load_scene_names("mine.toml", tmp_path).programs == programs
     write(tmp_path / "a.toml", 'extends = "b.toml"\n')
     write(tmp_path / "b.toml", 'extends = "a.toml"\n')

@@ -47,10 +47,13 @@ def test_usage_errors_exit_2_with_a_clear_message(
     assert capsys.readouterr().err.startswith(message)
 
 
-def test_missing_ticks_is_a_usage_error() -> None:
-    with pytest.raises(SystemExit) as info:
-        main(["tune", "lightbulb"])
-    assert info.value.code == 2
+def test_without_ticks_the_sweep_runs_at_the_scripts_own_tick(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    # reactions.dial says @tick 0.1 (the default without one would be 0.25 s).
+    assert main(["tune", "reactions", "--jobs", "1", "--json"]) == 0
+    table = json.loads(capsys.readouterr().out.splitlines()[-1])
+    assert [(t["tick"], t["trials"], t["successes"]) for t in table["ticks"]] == [(0.1, 1, 1)]
 
 
 def test_a_script_error_stops_the_sweep_before_it_starts(
