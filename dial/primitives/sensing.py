@@ -154,7 +154,7 @@ class Fit:
         self.ctx, self.set, self.fit, self.object = ctx, point_set, fit, learns
 
     def sense(self, snapshot: Snapshot) -> Ended:
-        from dial.haptics import FitError  # SciPy: only a run that fits loads it
+        from dial.haptics import FitError, PlaneFit  # SciPy: only a run that fits loads it
 
         points = np.array(self.ctx.point_sets.get(self.set, []), dtype=np.float64).reshape(-1, 3)
         try:
