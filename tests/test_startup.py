@@ -190,7 +190,7 @@ def test_the_preview_and_the_world_load_no_runner_and_no_solver_they_need_not(
     ],
     ids=["check", "preview", "run", "replay"],
 )
-def test_the_program_collects_garbage_in_the_commands_that_run_on(
+def test_the_program_collects_garbage_in_the_commands_that_run_on_and_lets_blas_sleep(
     args: list[str], collecting: bool, tmp_path: Path
 ) -> None:
     """The collector is off for the start-up (and a quick command, to its exit); a run
@@ -199,11 +199,13 @@ def test_the_program_collects_garbage_in_the_commands_that_run_on(
         (tmp_path / "short.dial").write_text(SHORT)
         args = ["run", str(tmp_path / "short.dial"), "--quiet"]
     program = (
-        "import gc, sys; from dial.cli import main; import dial.engine.setup as s; p = s.prepare\n"
+        "import gc, os, sys; from dial.cli import main; assert 'numpy' not in sys.modules\n"
+        "import dial.engine.setup as s; p = s.prepare\n"
         "def prepare(*a, **k):\n"
         "    print('at prepare', gc.isenabled(), gc.get_freeze_count() > 1000); return p(*a, **k)\n"
         "sys.modules['dial.engine.run'].prepare = prepare\n"
-        "status = main(); print('at exit', gc.isenabled()); sys.exit(status)"
+        "status = main(); print('at exit', gc.isenabled())\n"
+        "print('OpenBLAS', os.environ.get('OPENBLAS_THREAD_TIMEOUT')); sys.exit(status)"
     )
     env = dict(os.environ, DIAL_CACHE=str(tmp_path))
     done = subprocess.run(
@@ -217,6 +219,7 @@ def test_the_program_collects_garbage_in_the_commands_that_run_on(
     )
     said = done.stdout.splitlines()
     assert f"at exit {collecting}" in said, done.stdout + done.stderr
+    assert "OpenBLAS 4" in said  # its idle threads sleep at once (set before numpy loads)
     if args[0] == "run":
         assert "at prepare True True" in said  # on, what start-up made frozen
     from dial.cli import main
