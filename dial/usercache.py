@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import os
 import sys
-import tempfile
 import time
 from contextlib import suppress
 from pathlib import Path
@@ -39,6 +38,8 @@ def folder(name: str) -> Path | None:
 def replace(path: Path, data: bytes) -> None:
     """Replace ``path`` whole (a reader sees the old file or the new one), then remove the
     folder's other files that nothing has written for :data:`STALE_DAYS`."""
+    import tempfile  # only to write: ``import dial`` reads this module
+
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, temp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.stem}.", suffix=".tmp")
     try:
