@@ -9,7 +9,8 @@ in wall time and (in brackets) the process's CPU time:
 - ``dial --help``, ``import dial``, and ``dial check``, ``show`` and ``fmt --check`` of pour;
 - ``dial run pour.dial``: the whole process minus the wall time it prints, with the IK's
   cache (docs/architecture.md, "Start-up") as a user's second run finds it, and as the
-  first run ever (an empty cache);
+  first run ever (an empty cache); and a one-tick script's whole run, whose CPU time is
+  that overhead without the load's part;
 - ``dial preview pour.dial`` as a share of ``dial run``'s whole process, in wall time and
   in CPU time (both are one busy thread: on a loaded machine the CPU share is the steadier);
 - ``dial check`` of the 300 KB mutant of explore.dial with 75,000 problems
@@ -47,6 +48,7 @@ from mutant import write_mutant  # benchmarks/mutant.py
 
 ROOT = Path(__file__).resolve().parent.parent
 WALL = re.compile(r" in ([0-9.]+) s wall")
+ONE_TICK = '@scene pour\n@tick 0.25\n% pit_top hand_pose "knob_open"\npit_top #\n'
 Figure = tuple[float, float | None]  # wall time, CPU time (None: not measured)
 
 
@@ -130,6 +132,11 @@ def table(sides: list[Side], n: int, n_run: int, work: Path) -> None:
     row("dial run pour: whole process - its wall time", [w[0] for w in warm], "target <= 0.5 s")
     row("  the same, the first run (an empty IK cache)", [c[0] for c in cold])
     row("  dial run pour, whole process", [(w[1], w[2]) for w in warm])
+    # A run's start-up and exit with next to no run: its CPU time is the overhead above
+    # without what the load adds to the wall time.
+    one = work / "one_tick.dial"
+    one.write_text(ONE_TICK)
+    row("  dial run of a one-tick pour script, whole", best([*dial, "run", str(one)], fresh, n))
     preview = best([*dial, "preview", "scripts/pour.dial"], fresh, n_run)
     row("dial preview pour, whole process", preview)
     shares = [p[0] / w[1] for p, w in zip(preview, warm, strict=True)]

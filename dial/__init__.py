@@ -7,15 +7,19 @@ The public API (docs/api.md)::
     result = dial.run(dial.load("pour.dial"), perturb=10, seed=3)
     print(result.ok, result.success)
 
-``import dial`` loads nothing but this file (and ``dial.lazy``): each name below is imported
-from its module on first use (``dial.load`` brings the parser, ``dial.run`` the engine,
-MuJoCo on the first run), so that ``dial --help`` and ``dial check`` start quickly
+``import dial`` loads nothing but this file (with ``dial.lazy``, and ``dial.codecache``, which
+keeps the compiled code of dial's dataclasses in the user's cache): each name below is
+imported from its module on first use (``dial.load`` brings the parser, ``dial.run`` the
+engine, MuJoCo on the first run), so that ``dial --help`` and ``dial check`` start quickly
 (docs/architecture.md).
 """
 
 from typing import TYPE_CHECKING
 
+from dial import codecache
 from dial.lazy import lazy_names
+
+codecache.install()  # before any module of dial makes a dataclass
 
 if TYPE_CHECKING:
     from dial.api import load, run, save_world

@@ -7,6 +7,7 @@ right to left: the last module is the one this command imported)."""
 
 from __future__ import annotations
 
+import gc
 import importlib.util
 import os
 import subprocess
@@ -100,7 +101,8 @@ def test_import_dial_loads_nothing_but_itself(tmp_path: Path) -> None:
         text=True,
         check=True,
     )
-    assert done.stdout.strip() == "['dial.lazy']"  # what makes the names lazy
+    # what makes the names lazy, and the cache of the dataclasses' code (with its folder)
+    assert done.stdout.strip() == "['dial.codecache', 'dial.lazy', 'dial.usercache']"
     expect(chains(done.stderr), set(), "import dial")
 
 
@@ -176,3 +178,50 @@ def test_the_preview_and_the_world_load_no_runner_and_no_solver_they_need_not(
     expect(loads(preview, cache), {"mujoco"} | SOLVING, "dial preview (an empty IK cache)")
     expect(loads(preview, cache), {"mujoco"}, "dial preview (its IK problems in the cache)")
     expect(loads(["world", "pour"], cache), {"mujoco"}, "dial world")
+
+
+@pytest.mark.parametrize(
+    ("args", "collecting"),
+    [
+        (["check", POUR], False),
+        (["preview", POUR], False),
+        (["run", "short"], True),
+        (["replay", "no_such.jsonl"], True),  # any command that is not QUICK
+    ],
+    ids=["check", "preview", "run", "replay"],
+)
+def test_the_program_collects_garbage_in_the_commands_that_run_on_and_lets_blas_sleep(
+    args: list[str], collecting: bool, tmp_path: Path
+) -> None:
+    """The collector is off for the start-up (and a quick command, to its exit); a run
+    turns it on before the scene is loaded, with what it made until then frozen."""
+    if args == ["run", "short"]:
+        (tmp_path / "short.dial").write_text(SHORT)
+        args = ["run", str(tmp_path / "short.dial"), "--quiet"]
+    program = (
+        "import gc, os, sys; from dial.cli import main; assert 'numpy' not in sys.modules\n"
+        "import dial.engine.setup as s; p = s.prepare\n"
+        "def prepare(*a, **k):\n"
+        "    print('at prepare', gc.isenabled(), gc.get_freeze_count() > 1000); return p(*a, **k)\n"
+        "sys.modules['dial.engine.run'].prepare = prepare\n"
+        "status = main(); print('at exit', gc.isenabled())\n"
+        "print('OpenBLAS', os.environ.get('OPENBLAS_THREAD_TIMEOUT')); sys.exit(status)"
+    )
+    env = dict(os.environ, DIAL_CACHE=str(tmp_path))
+    done = subprocess.run(
+        [sys.executable, "-c", program, *args],
+        cwd=tmp_path,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=300,
+        check=False,
+    )
+    said = done.stdout.splitlines()
+    assert f"at exit {collecting}" in said, done.stdout + done.stderr
+    assert "OpenBLAS 4" in said  # its idle threads sleep at once (set before numpy loads)
+    if args[0] == "run":
+        assert "at prepare True True" in said  # on, what start-up made frozen
+    from dial.cli import main
+
+    assert main(["check", POUR]) == 0 and gc.isenabled()  # called as a function: untouched

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import gc
 import os
 import signal
 import sys
@@ -19,6 +20,15 @@ if TYPE_CHECKING:
 UsageError = OptionError  # a usage problem: exit status 2
 # Set by a command whose process must end at once after its last word (dial run --remote).
 EXIT_AT_ONCE = False
+
+
+def collect_from_here() -> None:
+    """Let the garbage collector run again, if the ``dial`` program stopped it for its
+    start-up (:func:`dial.cli.main`); what exists now is frozen: it lives to the exit, and
+    the collector need not look at it again."""
+    if not gc.isenabled():
+        gc.freeze()
+        gc.enable()
 
 
 def load_script(arg: str, scene: str | None) -> Script:

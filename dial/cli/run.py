@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING
 
 from dial.cli.common import (
     UsageError,
+    collect_from_here,
     dataset_arguments,
     dataset_request,
     load_script,
@@ -138,6 +139,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     check_remote(args)
     with catch_stop_signals() as stop:
         if args.remote is not None:
+            collect_from_here()
             return _remote(args, stop)
         return _run(args)
 
@@ -165,8 +167,10 @@ def _run_api(
     writer: DatasetWriter | None,
     cameras: list[str],
 ) -> RunResult:
-    from dial import api  # the parser and the engine: not for --help
+    # The parser and the engine (not for --help), all loaded before the collector runs again.
+    from dial import api, engine  # noqa: F401
 
+    collect_from_here()
     return api.run(
         args.script,
         scene=args.scene,

@@ -349,15 +349,15 @@ def _no_gc() -> Iterator[None]:
 
     Afterwards, freezing and at once unfreezing moves what the check made into the oldest
     generation without a pass over it (a young-generation pass over a large script's tree
-    costs a fifth of its check); it stays collectable there, as any long-lived data.
-    """
+    costs a fifth of its check); it stays collectable there, as any long-lived data."""
     enabled = gc.isenabled()
     gc.disable()
     try:
         yield
     finally:
-        gc.freeze()
-        gc.unfreeze()
+        if gc.get_freeze_count() == 0:  # else unfreezing frees what was frozen (dial's start)
+            gc.freeze()
+            gc.unfreeze()
         if enabled:
             gc.enable()
 

@@ -23,19 +23,15 @@ from __future__ import annotations
 
 import atexit
 import marshal
-import os
-import sys
-import tempfile
-import time
 from collections import OrderedDict
 from contextlib import suppress
 from pathlib import Path
 
 import numpy as np
 
+from dial import usercache
+
 MAX_SAVED = 20_000  # entries in one file (about 5 MB; read in about 10 ms)
-STALE_DAYS = 30  # files of other fingerprints untouched this long are removed on a write
-_OFF = ("", "0", "off", "no", "none", "false")
 
 Key = tuple[object, ...]
 Stored = bytes | tuple[float, ...]  # an array's float64 bytes, or a failed solve's figures
@@ -110,7 +106,7 @@ class Memo:
         merged.update(self._used)
         keep = dict(list(merged.items())[-MAX_SAVED:])
         with suppress(OSError, ValueError):
-            _write(folder / f"{self.fingerprint}.marshal", marshal.dumps(keep))
+            usercache.replace(folder / f"{self.fingerprint}.marshal", marshal.dumps(keep))
 
     def _keep(self, key: Key, value: object) -> None:
         self._values[key] = value
@@ -136,18 +132,9 @@ def _decoded(stored: Stored) -> object:
 
 
 def cache_dir() -> Path | None:
-    """The folder of the IK's files: ``$DIAL_CACHE``, else the user's cache folder; None
-    when ``DIAL_CACHE`` turns it off."""
-    chosen = os.environ.get("DIAL_CACHE")
-    if chosen is not None:
-        return None if chosen.strip().lower() in _OFF else Path(chosen) / "ik"
-    if sys.platform == "win32":
-        base = Path(os.environ.get("LOCALAPPDATA") or Path.home() / "AppData" / "Local")
-    elif sys.platform == "darwin":
-        base = Path.home() / "Library" / "Caches"
-    else:
-        base = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache")
-    return base / "dial" / "ik"
+    """The folder of the IK's files: ``$DIAL_CACHE/ik``, else in the user's cache folder;
+    None when ``DIAL_CACHE`` turns it off (:mod:`dial.usercache`)."""
+    return usercache.folder("ik")
 
 
 def _read(fingerprint: str) -> dict[Key, Stored]:
@@ -173,26 +160,6 @@ def _whole(value: object) -> bool:
     if isinstance(value, bytes):
         return len(value) % 8 == 0
     return isinstance(value, tuple) and all(type(x) is float for x in value)
-
-
-def _write(path: Path, data: bytes) -> None:
-    """Replace ``path`` whole (a reader sees the old file or the new one), then remove the
-    folder's files of other fingerprints that nothing has written for :data:`STALE_DAYS`."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, temp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.stem}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "wb") as f:
-            f.write(data)
-        os.replace(temp, path)
-    except BaseException:
-        with suppress(OSError):
-            os.unlink(temp)
-        raise
-    stale = time.time() - STALE_DAYS * 86400
-    for other in path.parent.iterdir():
-        with suppress(OSError):
-            if other != path and other.stat().st_mtime < stale:
-                other.unlink()
 
 
 _MEMOS: dict[str | None, Memo] = {}
