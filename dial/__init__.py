@@ -1,4 +1,5 @@
-"""dial: run DIAL-style tick-based timeline scripts on a simulated Utah/MIT hand on a PUMA 560.
+"""dial: run DIAL-style tick-based timeline scripts on a simulated robot hand and arm (the
+Utah/MIT hand on a PUMA 560, an Allegro-like hand on a Panda-like arm, or another robot).
 
 The public API (docs/api.md)::
 

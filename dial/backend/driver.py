@@ -20,10 +20,18 @@ from numpy.typing import NDArray
 
 from dial.backend.disturb import Disturbances
 from dial.backend.guards import Guard, Guards, Readings
-from dial.backend.locate import finger_bodies, link_point, tactile_point
-from dial.backend.model import IntArray, RobotIndex, hand_ctrl, robot_view, tendon_differentials
+from dial.backend.index import IntArray, RobotIndex
+from dial.backend.locate import link_point, tactile_point
+from dial.backend.model import (
+    finger_bodies,
+    hand_actuators,
+    hand_angles,
+    hand_ctrl,
+    joint_loads,
+    robot_view,
+    tendon_tensions,
+)
 from dial.backend.safety import Safety
-from dial.instructions.types import FINGERS
 from dial.robot.protocol import (
     Course,
     Fired,
@@ -37,6 +45,7 @@ from dial.robot.protocol import (
 from dial.robot.slots import ArmCourse, still
 from dial.robot.snapshot import FloatArray, Snapshot, Touch, Trip, frozen
 from dial.robot.view import RobotView
+from dial.robots.profile import RobotProfile
 from dial.scene.thread import Thread, find_threads
 
 CONTROL_PERIOD = 0.01  # s; physics runs at the model's timestep (0.002 s)
@@ -59,15 +68,18 @@ class MujocoRobot:
         data: mujoco.MjData,
         period: float = CONTROL_PERIOD,
         disturbances: Disturbances | None = None,
+        profile: RobotProfile | None = None,
     ) -> None:
+        """Drive the robot of ``profile`` (the default robot when None) in ``model``."""
         self.model, self.data = model, data
-        self.index = ix = RobotIndex.from_model(model)
+        self.index = ix = RobotIndex.from_model(model, profile)
+        self._fingers = tuple(f.name for f in ix.profile.fingers)
         self._dt = float(model.opt.timestep)  # looked up once: model.opt is slow to reach
         self.substeps = max(1, round(period / self._dt))
         self._period = self.substeps * model.opt.timestep
         self.steps = 0
         self.arm_target = data.qpos[ix.arm_qpos].copy()
-        self.hand_target = data.qpos[ix.hand_qpos].copy()
+        self.hand_target = hand_angles(data, ix)
         self.limp = np.zeros(16, dtype=bool)  # written through set_limp
         self._limping = False  # any limp joint: read every period, kept up to date
         self.threads: tuple[Thread, ...] = find_threads(model)
@@ -78,20 +90,35 @@ class MujocoRobot:
         self._fired: list[Fired] = []
         self.disturbances = disturbances or Disturbances.none()
         self._tactile_adr = [int(a) for a in ix.tactile_sensors]
-        # The four arrays' sensordata, in one fancy index: one copy per snapshot, not four.
-        self._tactile_idx = np.concatenate([np.arange(a, a + 256) for a in self._tactile_adr])
+        rows, cols = ix.profile.hand.taxels
+        self._taxels = rows * cols
+        self._tactile_shape = (len(self._fingers), rows, cols)
+        # The arrays' sensordata, in one fancy index: one copy per snapshot, not one each (a
+        # finger without an array reads the first array's, then zeros).
+        some = next((a for a in self._tactile_adr if a >= 0), 0)
+        self._no_tactile = [f for f, a in enumerate(self._tactile_adr) if a < 0]
+        self._tactile_idx = np.concatenate(
+            [
+                np.arange(a if a >= 0 else some, (a if a >= 0 else some) + rows * cols)
+                for a in self._tactile_adr
+            ]
+        )
         self.safety = Safety(model, data, ix, self._period)
         self._readings = Readings(data, ix, self._tactile_adr)
         # Control addresses as slices where they run in order (they do in dial's models):
         # writing a slice costs a fraction of writing through an index array.
         self._arm_ctrl = as_slice(ix.arm_actuators)
-        self._tendon_ctrl = as_slice(ix.tendon_actuators)
+        self._hand_ctrl = as_slice(hand_actuators(ix))
         # Both tendons of a joint servo to its angle (hand_ctrl): where the 32 controls run
         # in order, a (16, 2) view of them takes the 16 angles in one broadcast write.
-        tendons = data.ctrl[self._tendon_ctrl]
-        self._tendon_pairs = tendons.reshape(16, 2) if tendons.base is not None else None
-        self._finger_bodies = tuple(finger_bodies(model, f) for f in range(len(FINGERS)))
-        self._taxel_frames: dict[int, tuple[int, FloatArray]] = {}  # see _taxels
+        controls = data.ctrl[self._hand_ctrl]
+        pairs = ix.tendons and ix.full_hand and controls.base is not None
+        self._tendon_pairs = controls.reshape(16, 2) if pairs else None
+        self._finger_bodies = tuple(
+            frozenset(finger_bodies(model, f.joints)) for f in ix.profile.fingers
+        )
+        self._robot_root = int(model.body_rootid[model.site_bodyid[ix.tool_site]])
+        self._taxel_frames: dict[int, tuple[int, FloatArray]] = {}  # see _taxels_of
         self._view = robot_view(model, ix)
 
     @property
@@ -130,19 +157,21 @@ class MujocoRobot:
         dropped = self.disturbances.dropped
         # Fancy-indexed arrays are fresh copies: freeze them in place; copy only views.
         if name == "tactile":
-            tactile = d.sensordata[self._tactile_idx].reshape(4, 16, 16)
+            tactile = d.sensordata[self._tactile_idx].reshape(self._tactile_shape)
+            for f in self._no_tactile:
+                tactile[f] = 0.0
             for kind, f in dropped:
                 if kind == "tactile":
                     tactile[f] = 0.0
             return frozen(tactile, fresh=True)
         if name == "differentials":
-            differentials = tendon_differentials(d, ix)
+            differentials = joint_loads(d, ix)
             for kind, f in dropped:
                 if kind == "force":
                     differentials[4 * f : 4 * f + 4] = 0.0
             return frozen(differentials, fresh=True)
         if name == "hand_q":
-            q = d.qpos[ix.hand_qpos]
+            q = hand_angles(d, ix)
             for kind, f in dropped:
                 if kind == "position":
                     q[4 * f : 4 * f + 4] = hand_target[4 * f : 4 * f + 4]
@@ -150,7 +179,7 @@ class MujocoRobot:
         if name == "arm_q":
             return frozen(d.qpos[ix.arm_qpos], fresh=True)
         if name == "tensions":
-            return frozen(d.sensordata[ix.tension_sensors], fresh=True)
+            return frozen(tendon_tensions(d, ix), fresh=True)
         if name == "tool_pos":
             return frozen(d.site_xpos[ix.tool_site])
         if name == "tool_rot":
@@ -225,7 +254,7 @@ class MujocoRobot:
     def hold_all(self) -> None:
         ix = self.index
         self.arm_target = self.data.qpos[ix.arm_qpos].copy()
-        self.hand_target = self.data.qpos[ix.hand_qpos].copy()
+        self.hand_target = hand_angles(self.data, ix)
         self.set_limp(slice(None), False)
         self.guards.clear()
         self.monitors.clear()
@@ -236,16 +265,16 @@ class MujocoRobot:
         ix = self.index
         if "arm" in effectors:
             self.arm_target = self.data.qpos[ix.arm_qpos].copy()
-        for f, finger in enumerate(FINGERS):
+        for f, finger in enumerate(self._fingers):
             if finger in effectors:
                 joints = slice(4 * f, 4 * f + 4)
-                self.hand_target[joints] = self.data.qpos[ix.hand_qpos[joints]]
+                self.hand_target[joints] = hand_angles(self.data, ix)[joints]
                 self.set_limp(joints, False)
         self._apply()
 
     def watch(self, monitor: Monitor) -> int:
         kind, finger, threshold = monitor.contact
-        baseline = tendon_differentials(self.data, self.index)
+        baseline = joint_loads(self.data, self.index)
         guard = Guard(None, ((kind, threshold),), (finger,), baseline, monitor.negated)
         key = self.guards.add(guard)
         self.monitors.add(key)
@@ -267,13 +296,13 @@ class MujocoRobot:
 
     def measured_hand(self) -> FloatArray:
         """(16,) hand joint angles now (rad, mask order)."""
-        return np.asarray(self.data.qpos[self.index.hand_qpos], dtype=np.float64)
+        return hand_angles(self.data, self.index)
 
     def guard(
         self, effector: str, conditions: Iterable[tuple[str, float]], sense: Iterable[int]
     ) -> int:
         """Guard ``effector``: tested after every physics step until it trips."""
-        baseline = tendon_differentials(self.data, self.index)
+        baseline = joint_loads(self.data, self.index)
         return self.guards.add(Guard(effector, tuple(conditions), tuple(sense), baseline))
 
     def unguard(self, key: int) -> None:
@@ -283,28 +312,28 @@ class MujocoRobot:
         """Where ``finger`` touches now (a dropped-out tactile array locates nothing; see
         :mod:`dial.backend.locate`)."""
         tactile = None
-        if ("tactile", finger) not in self.disturbances.dropped:
-            a = self._tactile_adr[finger]
-            depths = self.data.sensordata[a : a + 256]
+        a = self._tactile_adr[finger]
+        if a >= 0 and ("tactile", finger) not in self.disturbances.dropped:
+            depths = self.data.sensordata[a : a + self._taxels]
             tactile = tactile_point(depths, self._taxel_points(finger))
-        return Touch(tactile, link_point(self.model, self.data, self._finger_bodies[finger]))
+        bodies = self._finger_bodies[finger]
+        return Touch(tactile, link_point(self.model, self.data, bodies, self._robot_root))
 
     def _taxel_points(self, finger: int) -> FloatArray:
         """(256, 3) world positions of a fingertip's taxels, in sensor order (m)."""
-        geom, local = self._taxels(finger)
+        geom, local = self._taxels_of(finger)
         rot = self.data.geom_xmat[geom].reshape(3, 3)
         points: FloatArray = self.data.geom_xpos[geom] + local @ rot.T
         return points
 
-    def _taxels(self, finger: int) -> tuple[int, FloatArray]:
+    def _taxels_of(self, finger: int) -> tuple[int, FloatArray]:
         """A fingertip's pad geom and its taxels in the geom's frame (looked up once)."""
         known = self._taxel_frames.get(finger)
         if known is not None:
             return known
         model = self.model
-        sensor = int(
-            mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SENSOR, f"hand_{FINGERS[finger]}_tactile")
-        )
+        name = self.index.profile.fingers[finger].tactile or ""
+        sensor = int(mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SENSOR, name))
         # A tactile sensor's object is its mesh; its reference is the geom that carries it.
         mesh, geom = int(model.sensor_objid[sensor]), int(model.sensor_refid[sensor])
         adr, n = int(model.mesh_vertadr[mesh]), int(model.mesh_vertnum[mesh])
@@ -317,11 +346,11 @@ class MujocoRobot:
         d.ctrl[self._arm_ctrl] = self.arm_target
         target = self.hand_target
         if self._limping:  # limp joints follow their measured angle
-            target = np.where(self.limp, d.qpos[self.index.hand_qpos], target)
+            target = np.where(self.limp, hand_angles(d, self.index), target)
         if self._tendon_pairs is not None:
             self._tendon_pairs[:] = target[:, None]
         else:
-            d.ctrl[self._tendon_ctrl] = hand_ctrl(target)
+            d.ctrl[self._hand_ctrl] = hand_ctrl(target, self.index)
 
     def _check_guards(self) -> None:
         readings = self._readings.at_step(self.hand_target, self.disturbances.dropped)
@@ -338,7 +367,7 @@ class MujocoRobot:
                     {
                         "effector": guard.effector,
                         "sensor": trip.kind,
-                        "finger": FINGERS[trip.finger],
+                        "finger": self._fingers[trip.finger],
                         "value": trip.value,
                         "t": trip.time,
                         "step": trip.step,
@@ -352,8 +381,8 @@ class MujocoRobot:
         if effector == "arm":
             self.arm_target = d.qpos[ix.arm_qpos].copy()
         else:
-            f = FINGERS.index(effector)
-            self.hand_target[4 * f : 4 * f + 4] = d.qpos[ix.hand_qpos[4 * f : 4 * f + 4]]
+            f = self._fingers.index(effector)
+            self.hand_target[4 * f : 4 * f + 4] = hand_angles(d, ix)[4 * f : 4 * f + 4]
         self._apply()
 
 

@@ -15,7 +15,8 @@ from dataclasses import dataclass, field
 import mujoco
 import numpy as np
 
-from dial.backend.model import RobotIndex, tendon_tensions
+from dial.backend.index import RobotIndex
+from dial.backend.model import hand_angles, tendon_tensions
 from dial.robot.contact import force_reading, position_reading, tactile_reading
 from dial.robot.snapshot import FloatArray, Trip
 
@@ -43,28 +44,33 @@ class Readings:
     :meth:`at_step` starts each step afresh."""
 
     __slots__ = (
-        "_data", "_diff", "_dropped", "_index", "_q", "_tactile", "_target",
-        "_tensions", "_tips",
+        "_bits", "_data", "_dropped", "_full", "_index", "_lever", "_loads", "_q", "_tactile",
+        "_target", "_tendons", "_tensions", "_tips",
     )  # fmt: skip
 
     def __init__(self, data: mujoco.MjData, index: RobotIndex, tactile_adr: Sequence[int]) -> None:
         self._data, self._index = data, index
         # Views into sensordata stay valid for the data's life: slicing once saves a lot.
-        self._tactile = [data.sensordata[a : a + 256] for a in tactile_adr]
+        n = index.profile.hand.taxels[0] * index.profile.hand.taxels[1]
+        self._tactile = [data.sensordata[a : a + n] if a >= 0 else None for a in tactile_adr]
         self._tips: list[float | None] | None = None  # this step's deepest taxel per finger
-        adr = index.tension_sensors
-        first = int(adr[0])
-        # The 32 tensions as a view where they run in order (flexor, extensor per joint).
-        in_order = np.array_equal(adr, np.arange(first, first + len(adr)))
+        adr = index.load_sensors
+        first = int(adr[0]) if len(adr) else -1
+        # The load readings as a view where they run in order (a tendon hand: flexor,
+        # extensor per joint).
+        in_order = first >= 0 and np.array_equal(adr, np.arange(first, first + len(adr)))
         self._tensions = data.sensordata[first : first + len(adr)] if in_order else None
+        self._bits: list[int] = index.hand_bits.tolist()  # each joint's mask bit
+        self._full, self._tendons = index.full_hand, index.tendons
+        self._lever = index.lever  # a joint torque (N m) over this is its load in N
         self._target: FloatArray = np.zeros(16)
         self._dropped: frozenset[tuple[str, int]] = frozenset()
-        self._diff: list[float] | None = None  # this step's 32 tensions (flexor, extensor)
+        self._loads: list[float] | None = None  # this step's 16 joint loads, Python floats
         self._q: FloatArray | None = None
 
     def at_step(self, target: FloatArray, dropped: frozenset[tuple[str, int]]) -> Readings:
         self._target, self._dropped = target, dropped
-        self._diff = self._q = self._tips = None
+        self._loads = self._q = self._tips = None
         return self
 
     def value(self, kind: str, f: int, baseline: Sequence[float]) -> float:
@@ -77,17 +83,34 @@ class Readings:
                 tips = self._tips = [None] * len(self._tactile)
             tip = tips[f]
             if tip is None:
-                tip = tips[f] = tactile_reading(self._tactile[f])
+                row = self._tactile[f]
+                tip = tips[f] = 0.0 if row is None else tactile_reading(row)
             return tip
-        if kind == "force":  # the tensions are read once per step, whatever the guards
-            if self._diff is None:
+        if kind == "force":  # the loads are read once per step, whatever the guards
+            if self._loads is None:
                 view = self._tensions
-                tensions = view if view is not None else tendon_tensions(self._data, self._index)
-                self._diff = tensions.tolist()
-            return force_reading(self._diff, baseline, f)
+                raw = view if view is not None else tendon_tensions(self._data, self._index)
+                self._loads = self._joint_loads(raw.tolist())
+            return force_reading(self._loads, baseline, f)
         if self._q is None:
-            self._q = self._data.qpos[self._index.hand_qpos]
+            self._q = hand_angles(self._data, self._index)
         return position_reading(self._target, self._q, f)
+
+    def _joint_loads(self, raw: list[float]) -> list[float]:
+        """The 16 joint loads (N, mask order, 0 where the hand has no joint) from the raw
+        load readings, in Python floats: :func:`dial.backend.model.joint_loads`."""
+        if self._tendons:
+            if self._full:
+                return [raw[2 * k] - raw[2 * k + 1] for k in range(16)]
+            loads = [0.0] * 16
+            for i, bit in enumerate(self._bits):
+                loads[bit] = raw[2 * i] - raw[2 * i + 1]
+            return loads
+        lever = self._lever
+        loads = [0.0] * 16
+        for i, bit in enumerate(self._bits):
+            loads[bit] = raw[i] / lever
+        return loads
 
 
 def first_trip(guard: Guard, r: Readings, time: float, step: int) -> Trip | None:

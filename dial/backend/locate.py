@@ -10,10 +10,11 @@ for that sensor's estimate: it lies on the link's surface, within half the penet
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import mujoco
 import numpy as np
 
-from dial.instructions.types import FINGERS
 from dial.robot.snapshot import FloatArray
 
 
@@ -29,20 +30,15 @@ def tactile_point(depths: FloatArray, taxels: FloatArray) -> FloatArray | None:
     return point
 
 
-def finger_bodies(model: mujoco.MjModel, finger: int) -> frozenset[int]:
-    """Ids of a finger's bodies: knuckle, proximal, medial and distal."""
-    prefix = f"hand_{FINGERS[finger]}_"
-    return frozenset(b for b in range(model.nbody) if model.body(b).name.startswith(prefix))
-
-
 def link_point(
-    model: mujoco.MjModel, data: mujoco.MjData, bodies: frozenset[int]
+    model: mujoco.MjModel, data: mujoco.MjData, bodies: frozenset[int], robot_root: int
 ) -> FloatArray | None:
     """The deepest contact point (3,) between the ``bodies`` and anything outside the robot
     (the first of equally deep ones, in MuJoCo's contact order).
 
     None when the finger touches nothing but the robot (or nothing at all). The contacts are
-    read as arrays: a scene full of balls has a hundred and more of them."""
+    read as arrays: a scene full of balls has a hundred and more of them. ``robot_root``: the
+    root body of the robot's tree (its arm's base, which carries the hand)."""
     n = data.ncon
     if n == 0:
         return None
@@ -53,7 +49,7 @@ def link_point(
     in1, in2 = np.isin(b1, finger), np.isin(b2, finger)
     other = np.where(in1, b2, b1)
     # One side is the finger (not both: the finger touching itself), the other not the robot.
-    hits = np.flatnonzero((in1 != in2) & (model.body_rootid[other] != _robot_root(model)))
+    hits = np.flatnonzero((in1 != in2) & (model.body_rootid[other] != robot_root))
     if len(hits) == 0:
         return None
     deepest = hits[np.argmin(contacts.dist[:n][hits])]
@@ -61,9 +57,10 @@ def link_point(
 
 
 def fingers_touching(
-    model: mujoco.MjModel, data: mujoco.MjData, body: str, fingers: tuple[int, ...]
+    model: mujoco.MjModel, data: mujoco.MjData, body: str, fingers: Sequence[frozenset[int]]
 ) -> int:
-    """How many of ``fingers`` have a link in contact with the body named ``body``."""
+    """How many of ``fingers`` (each a finger's bodies) have a link in contact with the body
+    named ``body``."""
     n = data.ncon
     if n == 0:
         return 0
@@ -71,7 +68,7 @@ def fingers_touching(
     b1 = model.geom_bodyid[data.contact.geom1[:n]]
     b2 = model.geom_bodyid[data.contact.geom2[:n]]
     other = np.concatenate([b2[b1 == target], b1[b2 == target]])
-    return sum(bool(np.isin(other, list(finger_bodies(model, f))).any()) for f in fingers)
+    return sum(bool(np.isin(other, list(f)).any()) for f in fingers)
 
 
 UPRIGHT = 0.7  # a contact normal within 45 deg of vertical: one body rests on the other
@@ -91,9 +88,3 @@ def resting_on(model: mujoco.MjModel, data: mujoco.MjData, body: str) -> tuple[s
         [b2[(b1 == target) & (up > UPRIGHT)], b1[(b2 == target) & (up < -UPRIGHT)]]
     )
     return tuple(model.body(int(b)).name for b in dict.fromkeys(above.tolist()))
-
-
-def _robot_root(model: mujoco.MjModel) -> int:
-    """The root body of the robot's tree (the PUMA's base, which carries the hand)."""
-    palm = int(mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, "hand_palm"))
-    return int(model.body_rootid[model.site_bodyid[palm]])

@@ -1,52 +1,73 @@
-"""Load the Utah/MIT hand on the PUMA 560 and name its parts.
+"""Load a robot (the Utah/MIT hand on the PUMA 560 by default) and read its sensors.
 
-:class:`RobotIndex` turns the model's names into the addresses the engine uses every physics
-step (qpos, dof, actuator and sensordata indices), once, so hot loops index numpy arrays
-instead of looking names up. Orders follow the paper's masks: hand joint ``k = 4*f + j`` with
-finger ``f`` (index, middle, ring, thumb) and joint ``j`` (abduction, MCP, PIP, DIP); tendon
-actuators ``2*k`` (flexor) and ``2*k + 1`` (extensor). See ``docs/model.md``.
+A robot is a folder with its MJCF and a ``robot.toml`` profile (``dial.robots``); a scene
+includes the robot's files by name. :class:`~dial.backend.index.RobotIndex` finds the
+profile's parts in a compiled model. Orders follow the paper's masks: hand joint
+``k = 4*f + j`` with finger ``f`` and joint ``j`` (abduction, then flexion from the palm out);
+a tendon hand's actuators ``2*k`` (flexor) and ``2*k + 1`` (extensor). See ``docs/model.md``
+and ``docs/robots.md``.
 """
 
 from __future__ import annotations
 
 import copy
+import functools
 import os
-from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import mujoco
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from dial.backend.index import HAND_BITS, FloatArray, IntArray, ModelError, RobotIndex
 from dial.errors import DialError
 from dial.resources import data_dir
 from dial.robot.view import FingerView, RobotView
+from dial.robots.profile import RobotProfile, default_profile, load_profile
 
 if TYPE_CHECKING:
     from dial.scene.world import World
 
+__all__ = [
+    "ARM_HOME",
+    "FloatArray",
+    "IntArray",
+    "ModelError",
+    "RobotIndex",
+    "default_profile",
+    "hand_angles",
+    "hand_ctrl",
+    "joint_loads",
+    "load_model",
+    "rest_hand",
+    "scene_bodies",
+    "tactile_images",
+    "tendon_differentials",
+    "tendon_tensions",
+]
+
+# The default robot: the one a world file that names none runs on.
 ROBOT_DIR = data_dir("models") / "utah_hand_puma"
 ROBOT_XML = ROBOT_DIR / "utah_hand_puma.xml"
-
-FINGERS = ("index", "middle", "ring", "thumb")
-ARM_JOINTS = tuple(f"puma_joint{i}" for i in range(1, 7))
-HAND_JOINTS = tuple(f"hand_{f}_j{j}" for f in FINGERS for j in range(4))
-TENDONS = tuple(f"{joint}_{kind}" for joint in HAND_JOINTS for kind in ("flexor", "extensor"))
+FINGERS = ("index", "middle", "ring", "thumb")  # its fingers, in mask order
 TAXEL_SHAPE = (16, 16)
 
-# Arm configuration (rad) with the palm 0.45 m above the floor, 0.55 m in front of the base,
-# facing down (tool z = -world z). A convenient start pose; world files name their own.
+# Arm configuration (rad) of the default robot with the palm 0.45 m above the floor, 0.55 m in
+# front of the base, facing down (tool z = -world z): its profile's home.
 ARM_HOME = (0.0, 0.7, -3.26, 0.0, -0.58, 0.0)
 
-IntArray = NDArray[np.intp]
-FloatArray = NDArray[np.float64]
+
+@functools.cache
+def profile_at(folder: Path) -> RobotProfile:
+    """The profile of the robot folder ``folder`` (read once per process)."""
+    return load_profile(folder)
 
 
-def _robot_files() -> dict[str, bytes]:
+def _robot_files(folder: Path) -> dict[str, bytes]:
     # MJCF resolves nested file names against the top-level file's folder; handing MuJoCo the
-    # files of the robot folder by name lets a scene anywhere include utah_hand_puma.xml.
-    return {path.name: path.read_bytes() for path in ROBOT_DIR.glob("*.xml")}
+    # files of the robot folder by name lets a scene anywhere include the robot's files.
+    return {path.name: path.read_bytes() for path in folder.glob("*.xml")}
 
 
 # Compiled models by (path, mtime, textures) once keep_compiled() is called; None: compile
@@ -72,27 +93,37 @@ def compiled_count() -> int:
     return 0 if _compiled is None else len(_compiled)
 
 
-def load_model(path: str | Path = ROBOT_XML, *, textures: bool = True) -> mujoco.MjModel:
-    """Compile the robot, or a scene XML file that includes ``utah_hand_puma.xml``;
+def load_model(
+    path: str | Path | None = None,
+    profile: RobotProfile | None = None,
+    *,
+    textures: bool = True,
+) -> mujoco.MjModel:
+    """Compile a robot (the default robot when ``profile`` is None), or a scene XML file that
+    includes its files; the profile's servo gains are written into the model's actuators.
     ``textures=False``: without its textures (:func:`load_untextured`)."""
+    profile = default_profile() if profile is None else profile
+    path = profile.model if path is None else path
     compile_model = _compile if textures else load_untextured
     if _compiled is None:
-        return compile_model(path)
-    key = (str(path), os.stat(path).st_mtime_ns, textures)
+        return compile_model(path, profile)
+    key = (f"{path}|{profile.path}", os.stat(path).st_mtime_ns, textures)
     model = _compiled.get(key)
     if model is None:
-        model = _compiled[key] = compile_model(path)
+        model = _compiled[key] = compile_model(path, profile)
     return copy.copy(model)
 
 
-def _compile(path: str | Path) -> mujoco.MjModel:
+def _compile(path: str | Path, profile: RobotProfile) -> mujoco.MjModel:
     try:
-        return mujoco.MjModel.from_xml_path(str(path), _robot_files())
+        model = mujoco.MjModel.from_xml_path(str(path), _robot_files(profile.folder))
     except ValueError as e:
         raise _compile_error(path, e) from None
+    apply_servo(model, RobotIndex.from_model(model, profile))
+    return model
 
 
-def load_untextured(path: str | Path) -> mujoco.MjModel:
+def load_untextured(path: str | Path, profile: RobotProfile | None = None) -> mujoco.MjModel:
     """Compile a scene without its textures, for what never draws it (``dial preview``, and
     ``dial run`` with no observer).
 
@@ -100,15 +131,18 @@ def load_untextured(path: str | Path) -> mujoco.MjModel:
     textures' fields, the materials' references to them and the name addresses differ: no
     physics reads them (tests/engine/test_textures.py runs a scene both ways, to the bit).
     """
+    profile = default_profile() if profile is None else profile
     try:
-        spec = mujoco.MjSpec.from_file(str(path), _robot_files())
+        spec = mujoco.MjSpec.from_file(str(path), _robot_files(profile.folder))
         for material in spec.materials:
             material.textures = [""] * len(material.textures)
         for texture in list(spec.textures):
             spec.delete(texture)
-        return spec.compile()
+        model = spec.compile()
     except ValueError as e:
         raise _compile_error(path, e) from None
+    apply_servo(model, RobotIndex.from_model(model, profile))
+    return model
 
 
 def _compile_error(path: str | Path, e: ValueError) -> DialError:
@@ -118,96 +152,70 @@ def _compile_error(path: str | Path, e: ValueError) -> DialError:
     return DialError(f"{path}: MuJoCo cannot compile the model: {why}")
 
 
-def load_model_from_string(xml: str) -> mujoco.MjModel:
-    """Compile scene XML text; it may ``<include file="utah_hand_puma.xml"/>`` by bare name."""
-    return mujoco.MjModel.from_xml_string(xml, _robot_files())
+def load_model_from_string(xml: str, profile: RobotProfile | None = None) -> mujoco.MjModel:
+    """Compile scene XML text; it may include the robot's files by bare name."""
+    profile = default_profile() if profile is None else profile
+    model = mujoco.MjModel.from_xml_string(xml, _robot_files(profile.folder))
+    apply_servo(model, RobotIndex.from_model(model, profile))
+    return model
 
 
-class ModelError(DialError, KeyError):
-    """A model that lacks a part of the robot dial drives (a scene without the hand, say)."""
+def apply_servo(model: mujoco.MjModel, index: RobotIndex) -> None:
+    """Write the profile's servo gains into the model's actuators.
 
-    def __str__(self) -> str:  # KeyError would quote the message
-        return str(self.args[0])
-
-
-def _ids(model: mujoco.MjModel, kind: mujoco.mjtObj, names: tuple[str, ...]) -> IntArray:
-    ids = np.array([mujoco.mj_name2id(model, kind, name) for name in names], dtype=np.intp)
-    missing = [name for name, i in zip(names, ids, strict=True) if i < 0]
-    if missing:
-        what = kind.name.removeprefix("mjOBJ_").lower()
-        raise ModelError(f"the model has no {what} {', '.join(missing)} of dial's robot")
-    ids.flags.writeable = False
-    return ids
-
-
-def _frozen(values: ArrayLike) -> IntArray:
-    array = np.asarray(values, dtype=np.intp)
-    array.flags.writeable = False
-    return array
-
-
-@dataclass(frozen=True, eq=False)
-class RobotIndex:
-    """Addresses of the robot's parts in one compiled model (robot alone or a scene).
-
-    Every array is read-only. Hand orders are mask order (16) and tendon order (32).
+    A position servo: ``kp (ctrl - q) - kv qdot``. A tendon: ``P + K (u - q) - D qdot`` on the
+    joint, pulled through the tendon's moment arm r, so gain K (negated for an extensor, as
+    the model has it) and bias ``[P, -K/r, -D/r]``.
     """
-
-    arm_qpos: IntArray
-    """(6,) qpos addresses of PUMA joints 1-6."""
-    arm_dof: IntArray
-    """(6,) dof addresses of PUMA joints 1-6."""
-    arm_actuators: IntArray
-    """(6,) ids of the arm position servos; their control is the joint angle in rad."""
-    hand_qpos: IntArray
-    """(16,) qpos addresses of the hand joints, mask order."""
-    hand_dof: IntArray
-    """(16,) dof addresses of the hand joints, mask order."""
-    tendon_actuators: IntArray
-    """(32,) ids of the tendon actuators: 2k flexor, 2k+1 extensor of hand joint k."""
-    tension_sensors: IntArray
-    """(32,) sensordata addresses of the tendon tensions (N), tendon order."""
-    tactile_sensors: IntArray
-    """(4,) sensordata addresses of the fingertip arrays: TAXEL_SHAPE depths come first."""
-    tool_site: int
-    """Site id of ``hand_palm``: palm centre, z out of the palm."""
-    fingertip_sites: IntArray
-    """(4,) site ids of ``hand_<finger>_tip``, finger order."""
-    moment_arm: float
-    """Tendon moment arm about every hand joint (m)."""
-    tension_limit: float
-    """Largest tension a tendon can pull with (N)."""
-
-    @classmethod
-    def from_model(cls, model: mujoco.MjModel) -> RobotIndex:
-        """Look up every name; raise :class:`ModelError` naming the parts the model lacks."""
-        arm = _ids(model, mujoco.mjtObj.mjOBJ_JOINT, ARM_JOINTS)
-        hand = _ids(model, mujoco.mjtObj.mjOBJ_JOINT, HAND_JOINTS)
-        tendons = _ids(model, mujoco.mjtObj.mjOBJ_ACTUATOR, TENDONS)
-        tensions = _ids(model, mujoco.mjtObj.mjOBJ_SENSOR, TENDONS)
-        tactile = _ids(
-            model, mujoco.mjtObj.mjOBJ_SENSOR, tuple(f"hand_{f}_tactile" for f in FINGERS)
+    arm = index.profile.arm
+    _position(model, index.arm_actuators, arm.kp, arm.kv)
+    servo = index.profile.hand.servo
+    if not index.tendons:
+        _position(model, index.hand_actuators, servo.kp, servo.kv)
+        return
+    for a in index.tendon_actuators:
+        sign = 1.0 if model.actuator_gainprm[a, 0] >= 0 else -1.0
+        model.actuator_gainprm[a, 0] = sign * servo.stiffness
+        model.actuator_biasprm[a, :3] = (
+            servo.pretension,
+            -servo.stiffness / index.lever,
+            -servo.damping / index.lever,
         )
-        tips = _ids(model, mujoco.mjtObj.mjOBJ_SITE, tuple(f"hand_{f}_tip" for f in FINGERS))
-        tool = _ids(model, mujoco.mjtObj.mjOBJ_SITE, ("hand_palm",))
-        # Each array reports depth and two sliding speeds per taxel.
-        if np.any(model.sensor_dim[tactile] != 3 * TAXEL_SHAPE[0] * TAXEL_SHAPE[1]):
-            raise ValueError(f"tactile arrays must have {TAXEL_SHAPE[0]}x{TAXEL_SHAPE[1]} taxels")
-        tendon_ids = model.actuator_trnid[tendons, 0]
-        return cls(
-            arm_qpos=_frozen(model.jnt_qposadr[arm]),
-            arm_dof=_frozen(model.jnt_dofadr[arm]),
-            arm_actuators=_ids(model, mujoco.mjtObj.mjOBJ_ACTUATOR, ARM_JOINTS),
-            hand_qpos=_frozen(model.jnt_qposadr[hand]),
-            hand_dof=_frozen(model.jnt_dofadr[hand]),
-            tendon_actuators=tendons,
-            tension_sensors=_frozen(model.sensor_adr[tensions]),
-            tactile_sensors=_frozen(model.sensor_adr[tactile]),
-            tool_site=int(tool[0]),
-            fingertip_sites=tips,
-            moment_arm=float(np.abs(model.wrap_prm[model.tendon_adr[tendon_ids]]).max()),
-            tension_limit=float(model.actuator_forcerange[tendons, 1].max()),
-        )
+
+
+def _position(
+    model: mujoco.MjModel, actuators: IntArray, kp: tuple[float, ...], kv: tuple[float, ...]
+) -> None:
+    model.actuator_gainprm[actuators, 0] = kp
+    model.actuator_biasprm[actuators, 1] = np.negative(kp)
+    model.actuator_biasprm[actuators, 2] = np.negative(kv)
+
+
+def finger_bodies(model: mujoco.MjModel, joints: tuple[str, ...]) -> tuple[int, ...]:
+    """Ids of a finger's links: the bodies its joints move, and theirs (a fingertip body),
+    by id."""
+    moved = {int(model.jnt_bodyid[model.joint(j).id]) for j in joints}
+    out = []
+    for b in range(model.nbody):
+        a = b
+        while a > 0 and a not in moved:
+            a = int(model.body_parentid[a])
+        if a in moved:
+            out.append(b)
+    return tuple(out)
+
+
+def hand_bodies(model: mujoco.MjModel, index: RobotIndex) -> frozenset[int]:
+    """Ids of the hand's bodies: everything the arm's last joint carries but its own link."""
+    last = int(model.jnt_bodyid[model.dof_jntid[index.arm_dof[-1]]])
+    out = set()
+    for b in range(model.nbody):
+        a = int(model.body_parentid[b])
+        while a > 0 and a != last:
+            a = int(model.body_parentid[a])
+        if a == last:
+            out.add(b)
+    return frozenset(out)
 
 
 def scene_bodies(model: mujoco.MjModel, world: World) -> list[int]:
@@ -224,68 +232,110 @@ def scene_bodies(model: mujoco.MjModel, world: World) -> list[int]:
 
 
 def robot_view(model: mujoco.MjModel, index: RobotIndex) -> RobotView:
-    """The read-only view of the Utah/MIT hand on the PUMA in ``model`` (its ranges as the
-    model has them)."""
+    """The read-only view of the robot in ``model`` (its ranges as the model has them)."""
+    profile = index.profile
     fingers = []
-    for f, name in enumerate(FINGERS):
-        prefix = f"hand_{name}_"
-        bodies = tuple(
-            n for n in (model.body(b).name for b in range(model.nbody)) if n.startswith(prefix)
-        )
-        joints = HAND_JOINTS[4 * f : 4 * f + 4]
-        fingers.append(FingerView(name, joints, f"{prefix}tip", f"{prefix}tactile", bodies))
-    hand = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, n) for n in HAND_JOINTS]
-    hand_range = model.jnt_range[hand].copy()
+    for finger in profile.fingers:
+        bodies = tuple(model.body(b).name for b in finger_bodies(model, finger.joints))
+        view = FingerView(finger.name, finger.joints, finger.tip_site, finger.tactile, bodies)
+        fingers.append(view)
+    hand_range = np.zeros((HAND_BITS, 2))
+    joints = [model.joint(j).id for f in profile.fingers for j in f.joints]
+    hand_range[index.hand_bits] = model.jnt_range[joints]
     arm_range = model.jnt_range[model.actuator_trnid[index.arm_actuators, 0]].copy()
     for array in (hand_range, arm_range):
         array.flags.writeable = False
     return RobotView(
-        "utah_hand_puma",
-        ARM_JOINTS,
+        profile.name,
+        profile.arm.joints,
         arm_range,
-        "hand_palm",
+        profile.arm.tool_site,
         tuple(fingers),
         hand_range,
-        "tendon",
-        TAXEL_SHAPE,
+        profile.hand.load,
+        profile.hand.taxels,
     )
 
 
-def hand_ctrl(q_desired: ArrayLike) -> FloatArray:
-    """Map 16 desired hand joint angles (rad, mask order) to the 32 tendon controls.
+def hand_ctrl(q_desired: ArrayLike, index: RobotIndex | None = None) -> FloatArray:
+    """The hand actuators' controls for desired joint angles (rad, (16,) mask order).
 
-    Both tendons of a joint servo to the same angle; the model's actuators add the
-    co-contraction pretension and the pull-only, tension-limited behaviour. Write the result
-    to ``data.ctrl[index.tendon_actuators]``.
+    A tendon hand: both tendons of a joint servo to the same angle (32 controls, tendon
+    order; the model's actuators add the co-contraction pretension and the pull-only,
+    tension-limited behaviour), to be written to ``data.ctrl[index.tendon_actuators]``. A
+    position-servoed hand: the angles of its joints, to ``data.ctrl[index.hand_actuators]``.
+    ``index`` None: the default robot (a tendon hand).
     """
     q = np.asarray(q_desired, dtype=np.float64)
-    if q.shape != (16,):
+    if q.shape != (HAND_BITS,):
         raise ValueError(f"expected 16 hand joint angles, got shape {q.shape}")
-    return np.repeat(q, 2)
+    if index is None or index.tendons:
+        bits = slice(None) if index is None else index.hand_bits
+        return np.repeat(q[bits], 2)
+    return q[index.hand_bits]
+
+
+def rest_hand(model: mujoco.MjModel, data: mujoco.MjData, index: RobotIndex) -> None:
+    """The hand straight, each joint at 0 or its nearest limit (a joint whose range leaves
+    out 0: the Allegro's thumb base), its servos holding there."""
+    joints = model.dof_jntid[index.hand_dof]
+    lo, hi = model.jnt_range[joints].T
+    data.qpos[index.hand_qpos] = np.clip(data.qpos[index.hand_qpos], lo, hi)
+    data.ctrl[hand_actuators(index)] = hand_ctrl(hand_angles(data, index), index)
+
+
+def hand_actuators(index: RobotIndex) -> IntArray:
+    """The hand's actuators that :func:`hand_ctrl`'s controls go to."""
+    return index.tendon_actuators if index.tendons else index.hand_actuators
+
+
+def hand_angles(data: mujoco.MjData, index: RobotIndex) -> FloatArray:
+    """(16,) hand joint angles (rad), mask order; 0 at bits the hand has no joint for."""
+    if index.full_hand:
+        return np.asarray(data.qpos[index.hand_qpos], dtype=np.float64)
+    q = np.zeros(HAND_BITS)
+    q[index.hand_bits] = data.qpos[index.hand_qpos]
+    return q
 
 
 def tendon_tensions(data: mujoco.MjData, index: RobotIndex) -> FloatArray:
-    """(32,) tendon tensions in N, tendon order; never negative (the actuators cannot push)."""
-    return np.asarray(data.sensordata[index.tension_sensors], dtype=np.float64)
+    """A tendon hand's tensions (N, tendon order); never negative (a tendon cannot push).
+    Another hand's raw load readings (joint torques, N m; or servo forces)."""
+    if index.profile.hand.load == "actuator":
+        return np.asarray(data.actuator_force[index.hand_actuators], dtype=np.float64)
+    return np.asarray(data.sensordata[index.load_sensors], dtype=np.float64)
 
 
-def tendon_differentials(data: mujoco.MjData, index: RobotIndex) -> FloatArray:
-    """(16,) flexor minus extensor tension per hand joint (N), mask order.
+def joint_loads(data: mujoco.MjData, index: RobotIndex) -> FloatArray:
+    """(16,) the load on each hand joint in N, mask order (0 where the hand has no joint).
 
-    Times the moment arm this is the tendon torque on the joint; at rest it balances the
-    load on the joint (contact forces; gravity is compensated).
+    A tendon hand: flexor minus extensor tension, which times the moment arm is the tendon
+    torque on the joint. Another hand: the joint torque its servo exerts over the profile's
+    lever. At rest it balances the load on the joint (contact forces; gravity is
+    compensated), so scripts' forces mean the same on every hand.
     """
-    tensions = tendon_tensions(data, index)
-    return tensions[0::2] - tensions[1::2]
+    raw = tendon_tensions(data, index)
+    loads = raw[0::2] - raw[1::2] if index.tendons else raw / index.lever
+    if index.full_hand:
+        return loads
+    out = np.zeros(HAND_BITS)
+    out[index.hand_bits] = loads
+    return out
+
+
+tendon_differentials = joint_loads  # the first robot's name for them
 
 
 def tactile_images(data: mujoco.MjData, index: RobotIndex) -> FloatArray:
-    """(4, 16, 16) penetration depth (m) at each taxel, finger order.
+    """(fingers, rows, columns) penetration depth (m) at each taxel, finger order; zero where
+    nothing touches, and for a finger without a tactile array.
 
-    ``[f, row, col]``: row 0 is the proximal edge of the pad and row 15 the distal edge; col
-    runs along the finger's local +x (the flexion axis). Zero where nothing touches.
+    ``[f, row, col]``: row 0 is the proximal edge of the pad and the last row the distal edge
+    (the first robot's columns: docs/model.md; the second's: its README).
     """
-    n = TAXEL_SHAPE[0] * TAXEL_SHAPE[1]
-    rows = index.tactile_sensors[:, None] + np.arange(n)
-    depths = np.asarray(data.sensordata[rows], dtype=np.float64)
-    return depths.reshape(len(FINGERS), *TAXEL_SHAPE)
+    rows, cols = index.profile.hand.taxels
+    out = np.zeros((len(index.tactile_sensors), rows, cols))
+    for f, adr in enumerate(index.tactile_sensors):
+        if adr >= 0:
+            out[f] = np.asarray(data.sensordata[adr : adr + rows * cols]).reshape(rows, cols)
+    return out

@@ -1,6 +1,7 @@
 """Engine-owned safety monitors, checked every control period; the script cannot switch
-them off: a diverged (non-finite) physics state, arm joints beyond their limits, and
-tendons held at their tension limit (a warning, not a fault)."""
+them off: a diverged (non-finite) physics state, arm joints beyond their limits, and hand
+drives held at their limit (a tendon at its tension limit, a joint servo at its torque
+limit: a warning, not a fault). The slack and the time are the robot profile's limits."""
 
 from __future__ import annotations
 
@@ -9,12 +10,8 @@ from collections.abc import Callable
 import mujoco
 import numpy as np
 
-from dial.backend.model import RobotIndex
-from dial.instructions.types import FINGERS
+from dial.backend.index import RobotIndex
 from dial.robot.protocol import Happening
-
-SATURATION_LIMIT_S = 1.0  # a tendon pinned at its tension limit this long is logged
-LIMIT_SLACK = 0.05  # rad: the servo may press a joint this far into its limit stop
 
 _DIVERGENCE = (
     mujoco.mjtWarning.mjWARN_BADQACC,
@@ -36,21 +33,24 @@ class Safety:
         # costs more than reading the time): at most period - 1 step after the reset.
         self._span = period - 0.5 * float(model.opt.timestep)
         self._due = data.time + self._span
+        limits = index.profile.limits
+        self._hold_s = limits.saturation_time  # a drive pinned at its limit this long is logged
         arm_range = model.jnt_range[model.actuator_trnid[index.arm_actuators, 0]]
         # Six comparisons a period: on Python floats they cost a third of numpy's.
-        lo, hi = (arm_range[:, 0] - LIMIT_SLACK).tolist(), (arm_range[:, 1] + LIMIT_SLACK).tolist()
+        slack = limits.joint_slack  # rad: the servo may press a joint this far into its stop
+        lo, hi = (arm_range[:, 0] - slack).tolist(), (arm_range[:, 1] + slack).tolist()
         self._arm_bounds = list(zip(lo, hi, strict=True))
-        self._pinned_at = index.tension_limit - 1e-6
+        self._pinned_at = index.load_limit - 1e-6
         # Views where the addresses run in order (a read through them copies nothing).
         self._arm_q = _view(data.qpos, index.arm_qpos)
-        self._tensions = _view(data.sensordata, index.tension_sensors)
-        self.saturated_since = np.full(32, -1.0)
-        self.saturation_logged = np.zeros(32, dtype=bool)
-        self._tracking = False  # a tendon is pinned now, or one was logged and still is
+        self._loads = _loads(data, index)
+        n = len(index.tendon_actuators) or len(index.hand_actuators)
+        self.saturated_since = np.full(n, -1.0)
+        self.saturation_logged = np.zeros(n, dtype=bool)
+        self._tracking = False  # a drive is pinned now, or one was logged and still is
 
     def check(self, time: float, happened: list[Happening]) -> str | None:
-        """A fault message, or None; appends a ``warning`` for a tendon held at its limit."""
-        ix = self.index
+        """A fault message, or None; appends a ``warning`` for a drive held at its limit."""
         # MuJoCo resets the state itself when it meets a bad qacc/qpos/qvel, and counts a
         # warning: a nonzero count is the divergence (the state is no longer the run's).
         now = self.data.time
@@ -62,14 +62,14 @@ class Safety:
         for (lo, hi), angle in zip(self._arm_bounds, self._arm_q().tolist(), strict=True):
             if not lo <= angle <= hi:
                 return self._beyond()
-        # A tendon pinned at its limit is not a fault (a fist pressed into the palm does it),
+        # A drive pinned at its limit is not a fault (a fist pressed into the palm does it),
         # but a researcher should know: log it once per episode.
-        tensions = self._tensions()
-        # The common case. The largest tension through argmax: numpy's max (its reduction
+        loads = self._loads()
+        # The common case. The largest load through argmax: numpy's max (its reduction
         # machinery) costs four times as much, and more just after a physics step.
-        if not self._tracking and tensions.item(tensions.argmax()) < self._pinned_at:
+        if not self._tracking and loads.item(loads.argmax()) < self._pinned_at:
             return None
-        pinned = tensions >= self._pinned_at
+        pinned = loads >= self._pinned_at
         if not pinned.any() and not self.saturation_logged.any():
             self.saturated_since.fill(-1.0)
             self._tracking = False
@@ -77,14 +77,9 @@ class Safety:
         self._tracking = True
         self.saturated_since[~pinned] = -1.0
         self.saturated_since[pinned & (self.saturated_since < 0)] = time
-        held = pinned & (time - self.saturated_since >= SATURATION_LIMIT_S)
+        held = pinned & (time - self.saturated_since >= self._hold_s)
         for k in np.flatnonzero(held & ~self.saturation_logged):
-            joint = int(k) // 2
-            message = (
-                f"{FINGERS[joint // 4]} joint {joint % 4} "
-                f"{'flexor' if k % 2 == 0 else 'extensor'} tendon held at its "
-                f"{ix.tension_limit:g} N limit for {SATURATION_LIMIT_S:g} s"
-            )
+            message = f"{self._drive(int(k))} held at its {self._limit} for {self._hold_s:g} s"
             happened.append(Happening("warning", {"t": time, "message": message}))
         self.saturation_logged = held | (self.saturation_logged & pinned)
         return None
@@ -97,12 +92,41 @@ class Safety:
         self._tracking = bool(self.saturation_logged.any() or (self.saturated_since >= 0).any())
         self._due = self.data.time + self._span
 
+    @property
+    def _limit(self) -> str:
+        unit = "N" if self.index.tendons else "N m"
+        return f"{self.index.load_limit:g} {unit} limit"
+
+    def _drive(self, k: int) -> str:
+        """A drive by its joint: "index joint 0 flexor tendon", "thumb joint 2"."""
+        ix = self.index
+        joint = k // 2 if ix.tendons else k
+        bit = int(ix.hand_bits[joint])
+        name = f"{ix.profile.fingers[bit // 4].name} joint {bit % 4}"
+        if not ix.tendons:
+            return name
+        return f"{name} {'flexor' if k % 2 == 0 else 'extensor'} tendon"
+
     def _beyond(self) -> str:
         """The fault message of the first arm joint beyond its limit."""
         q = self._arm_q().tolist()
         bounds = enumerate(zip(self._arm_bounds, q, strict=True))
         j = next(j for j, ((lo, hi), angle) in bounds if not lo <= angle <= hi)
-        return f"PUMA joint {j + 1} is beyond its limit ({np.degrees(q[j]):.1f} deg)"
+        arm = self.index.profile.arm.name
+        return f"{arm} joint {j + 1} is beyond its limit ({np.degrees(q[j]):.1f} deg)"
+
+
+def _loads(data: mujoco.MjData, index: RobotIndex) -> Callable[[], np.ndarray]:
+    """A reader of the hand drives' loads: tendon tensions (never negative), or the size of
+    the joint servos' torques."""
+    if index.tendons:
+        return _view(data.sensordata, index.load_sensors)
+    raw = (
+        _view(data.actuator_force, index.hand_actuators)
+        if index.profile.hand.load == "actuator"
+        else _view(data.sensordata, index.load_sensors)
+    )
+    return lambda: np.abs(raw())
 
 
 def _view(array: np.ndarray, index: np.ndarray) -> Callable[[], np.ndarray]:

@@ -14,7 +14,7 @@ import sys
 from collections.abc import Sequence
 
 from dial import __version__
-from dial.cli import common, preview, remote, replay, run, teach, text, tune
+from dial.cli import common, preview, remote, replay, robots, run, teach, text, tune
 from dial.cli.common import Terminated
 from dial.errors import DialError, OptionError, ScriptError
 
@@ -29,8 +29,9 @@ exit status: 0 ok, 1 script error (or, for fmt --check, a file that would change
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="dial",
-        description="Run DIAL-style tick-based timeline scripts on a simulated "
-        "Utah/MIT hand on a PUMA 560.",
+        description="Run DIAL-style tick-based timeline scripts on a simulated robot hand and\n"
+        "arm: the Utah/MIT hand on a PUMA 560, an Allegro-like hand on a Panda-like arm\n"
+        "(dial robots), or a robot folder of your own (docs/robots.md).",
         epilog=EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
@@ -42,6 +43,7 @@ def build_parser() -> argparse.ArgumentParser:
     tune.add_parser(sub)
     teach.add_parsers(sub)
     preview.add_parser(sub)
+    robots.add_parser(sub)
     remote.add_parsers(sub)
     return parser
 

@@ -44,7 +44,8 @@ def scene_argument(p: argparse.ArgumentParser, checking: bool = False) -> None:
         "--scene",
         metavar="NAME_OR_PATH",
         help=f"{what} this scene instead of the script's @scene (so do the scripts it "
-        "@calls): a world file path, else a bundled scene name",
+        "@calls): a world file path, else a bundled scene name (another robot's as "
+        "ROBOT/NAME, e.g. allegro_panda/pour)",
     )
 
 

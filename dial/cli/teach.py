@@ -61,7 +61,10 @@ def add_parsers(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> Non
         "also render the scene with every location drawn as a labelled frame.",
     )
     p.add_argument(
-        "scene", metavar="SCENE", nargs="?", help="a bundled scene name or a world file path"
+        "scene",
+        metavar="SCENE",
+        nargs="?",
+        help="a bundled scene name (ROBOT/NAME for another robot's) or a world file path",
     )
     p.add_argument("--picture", metavar="FILE.png", help="draw the named frames over the scene")
     p.add_argument(

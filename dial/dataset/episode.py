@@ -65,6 +65,7 @@ class Episode:
     info: EpisodeInfo
     videos: Mapping[str, bytes] = field(default_factory=dict)
     video_stats: Mapping[str, Mapping[str, NDArray[np.float64]]] = field(default_factory=dict)
+    robot_type: str = "utah_hand_puma"  # the robot profile's name (info.json's robot_type)
 
     @property
     def length(self) -> int:

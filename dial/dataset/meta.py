@@ -26,6 +26,7 @@ class Existing:
     stats: FeatureStats | None = None
     file_mb: float | None = None
     chunks_size: int | None = None
+    robot_type: str | None = None
 
 
 def read_existing(root: Path, fps: int) -> Existing:
@@ -66,6 +67,7 @@ def read_existing(root: Path, fps: int) -> Existing:
         raise DatasetError(f"cannot append to '{root}': {files.INFO} has no features")
     size = info.get("data_files_size_in_mb")
     chunks = info.get("chunks_size")
+    robot = info.get("robot_type")
     return Existing(
         features,
         episodes,
@@ -74,6 +76,7 @@ def read_existing(root: Path, fps: int) -> Existing:
         stats,
         float(size) if isinstance(size, int | float) else None,
         int(chunks) if isinstance(chunks, int) else None,
+        robot if isinstance(robot, str) else None,
     )
 
 

@@ -40,6 +40,7 @@ def check_request(request: Request) -> None:
 def expected_features(world: World, request: Request) -> dict[str, FeatureJSON]:
     """The data features of a run in ``world`` (MuJoCo loads: the robot's names live with
     its model)."""
+    from dial.backend.model import profile_at
     from dial.dataset.features import features
     from dial.dataset.robot import robot_names, scene_bodies
 
@@ -47,7 +48,7 @@ def expected_features(world: World, request: Request) -> dict[str, FeatureJSON]:
     if request.cameras:
         check_cameras(world, request.cameras)
     cameras = dict.fromkeys(request.cameras, CAMERA_SIZE)
-    spec = features(robot_names(), bodies, cameras, request.fps)
+    spec = features(robot_names(profile_at(world.robot)), bodies, cameras, request.fps)
     return {name: feature.as_json() for name, feature in spec.items()}
 
 
@@ -55,9 +56,9 @@ def check_cameras(world: World, names: tuple[str, ...]) -> None:
     """A usage error for a camera the scene's model lacks (its model is compiled for it)."""
     import mujoco
 
-    from dial.backend.model import load_model
+    from dial.backend.model import load_model, profile_at
 
-    model = load_model(world.model_path)
+    model = load_model(world.model_path, profile_at(world.robot))
     known = [
         "task",
         *(mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_CAMERA, i) for i in range(model.ncam)),

@@ -94,7 +94,8 @@ class Recorder:
 
             self.cameras = Cameras(robot, run.world, self.camera_names, self.fps)
         sizes = {} if self.cameras is None else self.cameras.sizes
-        self.spec = features(robot_names(), self.bodies, sizes, self.fps)
+        self.names = robot_names(robot.index.profile)
+        self.spec = features(self.names, self.bodies, sizes, self.fps)
         self.columns = _Columns(self.spec)
         scene = run.log.of("scene")
         self.seed = int(scene[-1].get("seed", 0)) if scene else 0  # type: ignore[call-overload]
@@ -173,4 +174,5 @@ class Recorder:
             info,
             videos,
             {} if self.cameras is None else self.cameras.stats(),
+            self.names.robot_type,
         )

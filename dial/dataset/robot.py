@@ -1,9 +1,11 @@
 """The one place a dataset reads the robot: joint positions, velocities, load, touch, the
 commands applied, and the objects' true poses, with the names of what it reads.
 
-Joint load is read through :meth:`RobotReader.joint_load` and named by
-:attr:`RobotNames.load`: tendon tensions on this hand; a hand without tendons (the robot
-profiles of issue 24) gives its joint torques here, under its own names.
+Everything is named after the robot's profile (``robot.toml``, docs/robots.md). Joint load is
+read through :meth:`RobotReader.joint_load` and named by :attr:`RobotNames.load`: the raw load
+readings of the profile's ``hand.load``, as :func:`dial.backend.model.tendon_tensions` gives
+them: 2 tendon tensions (N) per joint on a tendon hand (flexor, extensor), one joint torque
+(N m) per joint on a ``joint`` hand, one servo force per joint on an ``actuator`` hand.
 """
 
 from __future__ import annotations
@@ -14,20 +16,33 @@ import mujoco
 import numpy as np
 
 from dial.backend.driver import MujocoRobot
-from dial.backend.model import (
-    ARM_JOINTS,
-    FINGERS,
-    HAND_JOINTS,
-    TAXEL_SHAPE,
-    TENDONS,
-    FloatArray,
-)
+from dial.backend.model import FloatArray, hand_actuators, tendon_tensions
 from dial.dataset.features import RobotNames
+from dial.robots.profile import RobotProfile
+
+# A torque or servo-force reading is named after its joint: JOINT_torque, JOINT_force.
+_LOAD_SUFFIX = {"joint": "torque", "actuator": "force"}
 
 
-def robot_names() -> RobotNames:
-    """The Utah/MIT hand on the PUMA 560: 6 + 16 joints, 32 tendons, 4 pads of 16x16."""
-    return RobotNames(ARM_JOINTS, HAND_JOINTS, TENDONS, FINGERS, TAXEL_SHAPE)
+def robot_names(profile: RobotProfile) -> RobotNames:
+    """A robot's joints (arm, then hand in mask order), its load readings, its fingers and
+    their tactile arrays' size, by the names its profile gives (the Utah/MIT hand on the
+    PUMA 560: 6 + 16 joints, 32 tendons, 4 pads of 16x16)."""
+    fingers = profile.fingers
+    hand = tuple(j for f in fingers for j in f.joints)
+    if profile.hand.load == "tendon":
+        pairs = (zip(f.flexors, f.extensors, strict=True) for f in fingers)
+        load = tuple(name for finger in pairs for pair in finger for name in pair)
+    else:
+        load = tuple(f"{j}_{_LOAD_SUFFIX[profile.hand.load]}" for j in hand)
+    return RobotNames(
+        profile.arm.joints,
+        hand,
+        load,
+        tuple(f.name for f in fingers),
+        profile.hand.taxels,
+        profile.name,
+    )
 
 
 def scene_bodies(objects: Sequence[str]) -> tuple[str, ...]:
@@ -48,12 +63,24 @@ class RobotReader:
         self.model, self.data = m, robot.data
         self.qpos = np.concatenate([ix.arm_qpos, ix.hand_qpos])
         self.dof = np.concatenate([ix.arm_dof, ix.hand_dof])
-        self.load = np.asarray(ix.tension_sensors)
-        # The set-points applied: the arm's servos, and each hand joint's flexor (its
-        # extensor servos to the same angle, see dial.backend.model.hand_ctrl).
-        self.ctrl = np.concatenate([ix.arm_actuators, ix.tendon_actuators[0::2]])
-        n = TAXEL_SHAPE[0] * TAXEL_SHAPE[1]
-        self.tactile = np.concatenate([np.arange(a, a + n) for a in ix.tactile_sensors])
+        self.index = ix
+        # The set-points applied: the arm's servos, and each hand joint's servo (on a tendon
+        # hand its flexor: the extensor servos to the same angle, dial.backend.model.hand_ctrl).
+        hand = hand_actuators(ix)
+        self.ctrl = np.concatenate([ix.arm_actuators, hand[0::2] if ix.tendons else hand])
+        rows, cols = ix.profile.hand.taxels
+        n = rows * cols
+        # sensordata addresses of every taxel, finger by finger; a finger without a tactile
+        # array reads zeros (its slots are left out of ``taxels``).
+        have = [f for f, a in enumerate(ix.tactile_sensors) if a >= 0]
+        self.taxels = np.concatenate(
+            [np.arange(f * n, f * n + n) for f in have] or [np.zeros(0, np.intp)]
+        )
+        self.tactile = np.concatenate(
+            [np.arange(ix.tactile_sensors[f], ix.tactile_sensors[f] + n) for f in have]
+            or [np.zeros(0, np.intp)]
+        )
+        self.touch = np.zeros(len(ix.tactile_sensors) * n)
         self.free: list[tuple[int, int]] = []  # (slot in the pose vector, qpos address)
         self.fixed: list[tuple[int, int]] = []  # (slot, body id)
         for slot, name in enumerate(bodies):
@@ -72,12 +99,14 @@ class RobotReader:
         return np.asarray(self.data.qvel[self.dof])
 
     def joint_load(self) -> FloatArray:
-        """Tendon tensions (N), tendon order: the joint load of this hand."""
-        return np.asarray(self.data.sensordata[self.load])
+        """The hand's load readings (see the module's doc), in :attr:`RobotNames.load` order."""
+        return tendon_tensions(self.data, self.index)
 
     def tactile_depths(self) -> FloatArray:
-        """(fingers * rows * cols,) penetration depths (m), finger by finger, row-major."""
-        return np.asarray(self.data.sensordata[self.tactile])
+        """(fingers * rows * cols,) penetration depths (m), finger by finger, row-major; 0 on
+        a finger without a tactile array."""
+        self.touch[self.taxels] = self.data.sensordata[self.tactile]
+        return self.touch
 
     def commanded(self) -> FloatArray:
         """The joint set-points applied to the actuators now (rad)."""

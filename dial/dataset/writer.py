@@ -100,6 +100,8 @@ class DatasetWriter:
     ``root`` is created if need be. An existing dataset must have the same fps and, at the
     first :meth:`add` (or :meth:`check`), the same features; anything else in the folder is
     an error. ``file_mb`` is the data files' size limit (default: the dataset's, else 100).
+    info.json's ``robot_type`` is the robot of the episodes added (their profile's name; the
+    dataset's, else ``robot_type``, until one is added).
     """
 
     def __init__(
@@ -129,6 +131,7 @@ class DatasetWriter:
             self._unmake()
             raise
         self.features: dict[str, FeatureJSON] | None = existing.features
+        self.robot_type = existing.robot_type or robot_type
         self.file_bytes = int((file_mb or existing.file_mb or DEFAULT_FILE_MB) * 2**20)
         self.chunks_size = existing.chunks_size or CHUNKS_SIZE
         self._state = _Committed(
@@ -201,6 +204,7 @@ class DatasetWriter:
             self.commit()  # before this episode's task is known: it goes with the episode
         if self.features is None:
             self.features = all_features(dict(episode.features))
+        self.robot_type = episode.robot_type
         if episode.task not in self.tasks:
             self.tasks.append(episode.task)
         task = self.tasks.index(episode.task)

@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING, Protocol
 import numpy as np
 
 from dial.backend.driver import MujocoRobot
+from dial.backend.model import tendon_tensions
 from dial.parser.lanes import LanePlan
 from dial.scene.world import World
 from dial.scheduler.log import EventLog
@@ -116,7 +117,7 @@ class StateLog:
             tick=tick,
             t=periods * self.robot.period,
             qpos=np.round(d.qpos, STATE_DIGITS),
-            tension=np.round(d.sensordata[ix.tension_sensors], TENSION_DIGITS),
+            tension=np.round(tendon_tensions(d, ix), TENSION_DIGITS),
         )
 
     def end(self, result: RunResult | None) -> None:

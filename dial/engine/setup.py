@@ -15,7 +15,14 @@ from dial.backend.disturb import Disturbances
 from dial.backend.driver import MujocoRobot
 from dial.backend.ik import ArmIK, FingerIK
 from dial.backend.locate import fingers_touching, resting_on
-from dial.backend.model import ARM_HOME, RobotIndex, hand_ctrl, load_model, scene_bodies
+from dial.backend.model import (
+    RobotIndex,
+    finger_bodies,
+    load_model,
+    profile_at,
+    rest_hand,
+    scene_bodies,
+)
 from dial.disturb import Disturbance
 from dial.geometry import Pose, location_pose, rpy_matrix
 from dial.parser.script import Script
@@ -23,7 +30,7 @@ from dial.primitives.context import Context
 from dial.robot.snapshot import Snapshot
 from dial.scene.belief import Beliefs, Feeling, initial
 from dial.scene.of_script import script_world
-from dial.scene.resolve import worlds_dir
+from dial.scene.resolve import bundled_name
 from dial.scene.thread import set_turns
 from dial.scene.world import World
 from dial.scheduler.log import EventLog
@@ -72,10 +79,11 @@ def prepare(
     the physics is the same to the bit, and the compile is a fifth of the time).
     ``follow=False``: grasped objects do not follow the hand in the world model."""
     world = script_world(script)
-    model = load_model(world.model_path, textures=textures)
+    profile = profile_at(world.robot)
+    model = load_model(world.model_path, profile, textures=textures)
     set_turns(model, world)
     placed = Disturbances.on(model, disturbances)  # an unknown body fails before anything moves
-    index = RobotIndex.from_model(model)
+    index = RobotIndex.from_model(model, profile)
     unmoved = mujoco.MjData(model)
     mujoco.mj_forward(model, unmoved)
     at_load: dict[str, Pose] = {
@@ -85,35 +93,36 @@ def prepare(
     believed, sizes = initial(world, at_load)
     shift = perturb(model, world, perturb_mm, seed)
     data = mujoco.MjData(model)
-    ik = ArmIK()
+    ik = ArmIK(profile=profile)
     if "home" in world.locations:
         pos, rot = location_pose(world, believed, "home")
     else:
         pos, rot = np.array(START[0]), rpy_matrix(START[1])
-    home = ik.solve(pos, rot, np.array(ARM_HOME), "the start pose (location 'home')")
+    home = ik.solve(pos, rot, np.array(profile.arm.home), "the start pose (location 'home')")
     data.qpos[index.arm_qpos] = home
     data.ctrl[index.arm_actuators] = home
-    data.ctrl[index.tendon_actuators] = hand_ctrl(data.qpos[index.hand_qpos])
+    rest_hand(model, data, index)
     mujoco.mj_forward(model, data)
     for _ in range(round(SETTLE_S / model.opt.timestep)):
         mujoco.mj_step(model, data)
-    # A bundled world by its file name; another by its absolute path, so that dial replay
-    # finds it from anywhere.
-    bundled = world.path.parent == worlds_dir().resolve()
-    where = world.path.name if bundled else str(world.path)
+    # A bundled world by its name as a file ("pour.toml", "allegro_panda/pour.toml");
+    # another by its absolute path, so that dial replay finds it from anywhere.
+    bundled = bundled_name(world.path)
+    where = f"{bundled}.toml" if bundled else str(world.path)
     log.write("scene", scene=world.name, world=where, perturb=shift, seed=seed)
-    robot = MujocoRobot(model, data, disturbances=placed)
+    robot = MujocoRobot(model, data, disturbances=placed, profile=profile)
     beliefs = Beliefs(world, believed, sizes, follow=follow, feeling=feeling(robot))
-    ctx = Context(robot, robot.view, world, believed, ik, FingerIK(ik.model), beliefs=beliefs)
-    return robot, ctx
+    fik = FingerIK(ik.model, profile)
+    return robot, Context(robot, robot.view, world, believed, ik, fik, beliefs=beliefs)
 
 
 def feeling(robot: MujocoRobot) -> Feeling:
     """What the world model asks of the physics: which fingers touch an object, what rests
     on one (:mod:`dial.backend.locate`), and the time."""
     m, d = robot.model, robot.data
+    links = [frozenset(finger_bodies(m, f.joints)) for f in robot.index.profile.fingers]
     return Feeling(
-        lambda body, fingers: fingers_touching(m, d, body, fingers),
+        lambda body, fingers: fingers_touching(m, d, body, [links[f] for f in fingers]),
         lambda body: resting_on(m, d, body),
         lambda: robot.time,
     )

@@ -288,12 +288,13 @@ class StateFile:
             target.flat[:] = _floats(d["derived"][name], target.size, name)
         r = d["robot"]
         robot.steps = int(r["steps"])
-        robot.arm_target = _floats(r["arm_target"], 6, "arm_target")
+        robot.arm_target = _floats(r["arm_target"], robot.arm_target.size, "arm_target")
         robot.hand_target = _floats(r["hand_target"], 16, "hand_target")
         robot.set_limp(slice(None), _flags(r["limp"], robot.limp.size, "limp"))
+        drives = robot.safety.saturated_since.size
         robot.safety.restore(
-            _floats(r["saturated_since"], 32, "saturated_since"),
-            _flags(r["saturation_logged"], 32, "saturation_logged"),
+            _floats(r["saturated_since"], drives, "saturated_since"),
+            _flags(r["saturation_logged"], drives, "saturation_logged"),
         )
         robot.disturbances.resume_at(robot.steps)
         ctx.point_sets.update(d["contacts"])

@@ -28,35 +28,53 @@ HAND_RANGES: dict[str, tuple[float, float]] = {
 _SLACK = 1e-6  # rad: a value written as the limit in degrees is within it
 
 
-def _deg(rad: float) -> str:
-    return f"{round(math.degrees(rad), 1):g}"
+def _deg(rad: float, digits: int = 1) -> str:
+    return f"{round(math.degrees(rad), digits):g}"
 
 
-def drive_problem(joint: int, angle: float) -> str | None:
+def _digits(excess: float) -> int:
+    """Decimals that show an excess (rad) as more than 0 deg (a limit of 79.98 deg, not 80)."""
+    digits = 1
+    while digits < 4 and round(math.degrees(excess), digits) == 0:
+        digits += 1
+    return digits
+
+
+def drive_problem(
+    joint: int,
+    angle: float,
+    ranges: tuple[tuple[float, float], ...] = ARM_RANGES,
+    arm: str = "PUMA",
+) -> str | None:
     """Why ``DRIVE joint angle`` (relative, rad) cannot stay in joint's range, or None.
 
     A drive turns the joint from wherever it is, so only a turn larger than the whole range
-    is known to overshoot before the run.
+    is known to overshoot before the run. ``ranges``: the arm's (the PUMA's by default), and
+    ``arm`` what messages call it.
     """
-    lo, hi = ARM_RANGES[joint - 1]
+    if not 1 <= joint <= len(ranges):
+        return f"the {arm} has joints 1 to {len(ranges)}, not {joint}"
+    lo, hi = ranges[joint - 1]
     excess = abs(angle) - (hi - lo)
     if excess <= _SLACK:
         return None
     return (
-        f"a drive of {_deg(angle)} deg takes PUMA joint {joint} beyond its range "
+        f"a drive of {_deg(angle)} deg takes {arm} joint {joint} beyond its range "
         f"({_deg(lo)} to {_deg(hi)} deg, {_deg(hi - lo)} deg in all) by {_deg(excess)} deg "
         "from wherever it starts"
     )
 
 
-def hand_problem(kind: str, angle: float) -> str | None:
-    """Why a hand pose angle (rad) of a joint of ``kind`` is out of its range, or None."""
-    lo, hi = HAND_RANGES[kind]
+def hand_problem(kind: str, angle: float, limits: tuple[float, float] | None = None) -> str | None:
+    """Why a hand pose angle (rad) of a joint of ``kind`` is out of its range (``limits``,
+    else the first robot's for that kind), or None."""
+    lo, hi = HAND_RANGES[kind] if limits is None else limits
     if lo - _SLACK <= angle <= hi + _SLACK:
         return None
     limit, excess = (lo, lo - angle) if angle < lo else (hi, angle - hi)
     side = "lower" if angle < lo else "upper"
+    n = _digits(excess)
     return (
-        f"{_deg(angle)} deg is beyond the {kind} joint's {side} limit of {_deg(limit)} deg "
-        f"by {_deg(excess)} deg (its range is {_deg(lo)} to {_deg(hi)} deg)"
+        f"{_deg(angle, n)} deg is beyond the {kind} joint's {side} limit of {_deg(limit, n)} deg "
+        f"by {_deg(excess, n)} deg (its range is {_deg(lo, n)} to {_deg(hi, n)} deg)"
     )

@@ -16,7 +16,6 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from dial.instructions.base import Args, Instruction, ParamSpec, Values
-from dial.instructions.limits import drive_problem
 from dial.instructions.scene_names import SceneNames
 from dial.instructions.types import ARM, Choice, Integer, Name, Quantity
 from dial.scene.valii import Appro, Depart, Drive, Move, Statement
@@ -33,7 +32,9 @@ _MOVES_TO = ParamSpec("location", Name("location"), doc="straight-line move")
 _APPRO_TO = ParamSpec("location", Name("location"))
 _APPRO_BY = ParamSpec("distance", Quantity("length", "m", 0.0, 1.0), doc="back along tool z")
 _DEPART_BY = ParamSpec("distance", Quantity("length", "m", -1.0, 1.0), doc="back along tool z")
-_JOINT = ParamSpec("joint", Integer(1, 6))
+_JOINT = ParamSpec(
+    "joint", Integer(1, 9), doc="the arm's joint (1-6 on the PUMA, 1-7 on the Panda)"
+)
 _ANGLE = ParamSpec(
     "angle", Quantity("angle", "deg", -6.2832, 6.2832), doc="degrees unless suffixed"
 )
@@ -78,12 +79,6 @@ class PumaStatementArgs(_PumaArgs):
 
     statement: Statement
     verb: str
-
-    def problem(self) -> str | None:
-        match self.statement:
-            case Drive(joint=joint, angle=angle):
-                return drive_problem(joint, angle)
-        return None
 
     def primitive(self, ctx: Context, allotted: Allotment) -> Primitive[Snapshot]:
         from dial.primitives.arm import PumaStatement

@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from dial.errors import DialError
+from dial.robots.facts import RobotFacts
 
 
 @dataclass(frozen=True)
@@ -20,7 +21,8 @@ class SceneNames:
 
     ``poses`` maps each named hand pose to the 16-bit joint mask it sets
     (bit ``4*f + j``; a pose that sets every joint has mask ``0xFFFF``). ``anchored``: the
-    locations that are relative to an object; ``objects``: the object aliases.
+    locations that are relative to an object; ``objects``: the object aliases; ``robot``:
+    what the scene's robot has (None: the default robot).
     """
 
     name: str
@@ -29,6 +31,7 @@ class SceneNames:
     programs: frozenset[str] = frozenset()
     objects: frozenset[str] = frozenset()
     anchored: frozenset[str] = frozenset()
+    robot: RobotFacts | None = None
 
 
 class SceneNotFoundError(DialError, LookupError):

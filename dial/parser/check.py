@@ -18,6 +18,7 @@ from pathlib import Path
 from dial.errors import MAX_PROBLEMS, Diagnostic, ScriptError, Span, TooManyProblems, tally
 from dial.instructions.base import Instruction, Values
 from dial.instructions.catalogue import INSTRUCTIONS, WATCHABLE
+from dial.instructions.robot_checks import robot_errors
 from dial.instructions.scene_names import SceneLoader, SceneNames, SceneNotFoundError
 from dial.instructions.types import EFFECTORS, Contact, Name, Names
 from dial.parser.ast import Call, Condition, Definition, ExecLine, Program
@@ -139,14 +140,12 @@ class _Checker:
         instr = INSTRUCTIONS.get(d.instruction)
         if instr is None:
             valid = list(INSTRUCTIONS)
-            self.error(
-                d.instruction_span,
-                f"unknown instruction '{d.instruction}'"
-                + (_hint(d.instruction, valid) or _choices(valid)),
-            )
+            hint = _hint(d.instruction, valid) or _choices(valid)
+            self.error(d.instruction_span, f"unknown instruction '{d.instruction}'{hint}")
             self.broken.add(d.event)
             return
         bound, errors = bind(instr, d, limit=MAX_PROBLEMS - self.seen)
+        errors = errors or robot_errors(d, bound, self.scene.robot if self.scene else None)
         for span, message in errors:
             self.error(span, f"event '{d.event}': {message}")
         if errors:

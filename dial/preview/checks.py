@@ -15,7 +15,6 @@ from typing import Protocol
 
 import numpy as np
 
-from dial.instructions.types import FINGERS
 from dial.preview.scene import Scene
 from dial.primitives.arm import Segment
 from dial.primitives.hand import FingerMove, HandPose
@@ -58,7 +57,7 @@ def finger_goal(scene: Scene, prim: FingerMove) -> list[str]:
     if off <= TIP_TOL:
         return []
     return [
-        f"the {_finger(prim.finger)} fingertip stops {off * 1000:.1f} mm short of its goal "
+        f"the {scene.fingers[prim.finger]} fingertip stops {off * 1000:.1f} mm short of its goal "
         "(a joint limit, or out of the finger's reach)"
     ]
 
@@ -104,11 +103,7 @@ def hand_pose(scene: Scene, prim: HandPose) -> list[str]:
             continue
         side, limit = ("lower", lo) if angle < lo else ("upper", hi)
         out.append(
-            f"hand pose '{name}' sets the {_finger(k // 4)} {JOINTS[k % 4]} joint to "
+            f"hand pose '{name}' sets the {scene.fingers[k // 4]} {JOINTS[k % 4]} joint to "
             f"{np.degrees(angle):.1f} deg, beyond its {side} limit {np.degrees(limit):.1f} deg"
         )
     return out
-
-
-def _finger(f: int) -> str:
-    return FINGERS[f]

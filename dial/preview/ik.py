@@ -29,6 +29,7 @@ from dial.backend.ik import (
 )
 from dial.robot.memo import memo_key
 from dial.robot.snapshot import FloatArray
+from dial.robots.profile import RobotProfile
 
 LEAN_ITERATIONS = 30  # per start of LeanArmIK.solve, before it leaves one to mink
 
@@ -49,8 +50,11 @@ class LeanArmIK(ArmIK):
 
     MEMO = "lean-arm"
 
-    def __init__(self, model: mujoco.MjModel | None = None) -> None:
-        super().__init__(model)
+    def __init__(
+        self, model: mujoco.MjModel | None = None, profile: RobotProfile | None = None
+    ) -> None:
+        super().__init__(model, profile)
+        self.MEMO = f"lean-arm:{self.robot}"
         self._qpos, self._dof = _as_slice(self.index.arm_qpos), _as_slice(self.index.arm_dof)
         self._velocity = np.zeros(self.model.nv)
         self._tools: dict[bytes, FloatArray] = {}  # fk (position, rotation) where tracks ended
@@ -77,9 +81,16 @@ class LeanArmIK(ArmIK):
         return known[:3].copy(), known[3:].reshape(3, 3).copy()
 
     def track(
-        self, pos: FloatArray, rot: FloatArray, arm_q: FloatArray, iterations: int = 2
+        self,
+        pos: FloatArray,
+        rot: FloatArray,
+        arm_q: FloatArray,
+        iterations: int = 2,
+        guide: FloatArray | None = None,
     ) -> FloatArray:
-        """:meth:`ArmIK.track`, the lean way."""
+        """:meth:`ArmIK.track`, the lean way (a redundant arm's guided line: mink's QP)."""
+        if guide is not None and self.redundant:
+            return super().track(pos, rot, arm_q, iterations, guide)
         key = memo_key(f"{self.MEMO}-track", pos, rot, arm_q, iterations)
         known = self.memo.get(key)
         if isinstance(known, np.ndarray):
@@ -96,7 +107,11 @@ class LeanArmIK(ArmIK):
             data.qpos[self._qpos] = arm_q
             self.config.update()
 
-    def _iterate(self, pos: FloatArray, rot: FloatArray, iterations: int) -> tuple[float, float]:
+    def _iterate(
+        self, pos: FloatArray, rot: FloatArray, iterations: int, posture: bool = False
+    ) -> tuple[float, float]:
+        if self.redundant:  # a posture task: mink's QP as it is
+            return super()._iterate(pos, rot, iterations, posture)
         import mink
 
         task, config = self.task, self.config
@@ -199,13 +214,16 @@ class FingerIKOnDemand(FingerIK):
     """The fingers' IK, on a copy of the arm's model, set up when a run first uses it (most
     scripts never do)."""
 
-    def __init__(self, model: mujoco.MjModel) -> None:  # FingerIK's own waits for _ready
+    def __init__(  # FingerIK's own waits for _ready
+        self, model: mujoco.MjModel, profile: RobotProfile | None = None
+    ) -> None:
         self._pending: mujoco.MjModel | None = model
+        self._profile = profile
 
     def _ready(self) -> None:
         if self._pending is not None:
             model, self._pending = self._pending, None
-            super().__init__(copy.copy(model))
+            super().__init__(copy.copy(model), self._profile)
 
     # The two ways in (their arguments as FingerIK's, which callers are checked against).
     def tip(self, *args: Any, **kwargs: Any) -> FloatArray:

@@ -20,7 +20,6 @@ from collections.abc import Callable
 import numpy as np
 
 from dial.backend.ik import IKError
-from dial.instructions.types import FINGERS
 from dial.preview.moves import Check, Found
 from dial.preview.places import Places
 from dial.preview.scene import HAND, Scene, State, finger_group
@@ -135,7 +134,7 @@ def guarded(
             _bisect(scene, before, reach, s, s_next, groups)
             return Found(Outcome.DONE)
         if lag > LAG:
-            who = "the tool" if finger is None else f"the {FINGERS[finger]} fingertip"
+            who = "the tool" if finger is None else f"the {scene.fingers[finger]} fingertip"
             return Found(
                 Outcome.MISSED,
                 [

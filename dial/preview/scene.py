@@ -17,8 +17,14 @@ import numpy as np
 
 from dial.backend.driver import MujocoRobot
 from dial.backend.ik import ArmIK
-from dial.backend.model import ARM_HOME, load_model, load_untextured, scene_bodies
-from dial.instructions.types import FINGERS
+from dial.backend.model import (
+    finger_bodies,
+    load_model,
+    load_untextured,
+    profile_at,
+    rest_hand,
+    scene_bodies,
+)
 from dial.preview.ik import FingerIKOnDemand, LeanArmIK
 from dial.primitives.context import Context
 from dial.robot.snapshot import FloatArray
@@ -27,7 +33,7 @@ from dial.teach.contacts import FIXED_DEPTH, OBJECT_DEPTH, Parts
 from dial.teach.sim import home_pose
 
 ARM, PALM = 0, 1  # geom groups of the robot; finger f is group 2 + f, anything else -1
-HAND: frozenset[int] = frozenset({PALM, *(2 + f for f in range(len(FINGERS)))})
+HAND: frozenset[int] = frozenset({PALM, *(2 + f for f in range(4))})  # at most 4 fingers
 SELF_DEPTH = 0.001  # m: fingers may touch each other; deeper, the pose cannot be reached
 RELEASE = np.radians(2.0)  # a gripping finger opened this much lets go of what it holds
 
@@ -36,16 +42,15 @@ def finger_group(finger: int) -> int:
     return 2 + finger
 
 
-_PART = {
-    ARM: "arm",
-    PALM: "palm",
-    **{2 + f: name if name == "thumb" else f"{name} finger" for f, name in enumerate(FINGERS)},
-}
+def part_names(fingers: tuple[str, ...]) -> dict[int, str]:
+    """What messages call each geom group: "arm", "palm", "index finger", "thumb"."""
+    named = {2 + f: name if name == "thumb" else f"{name} finger" for f, name in enumerate(fingers)}
+    return {ARM: "arm", PALM: "palm", **named}
 
 
-def _effectors(*groups: int) -> tuple[str, ...]:
+def effectors_of(fingers: tuple[str, ...], *groups: int) -> tuple[str, ...]:
     """The effectors that move robot parts of ``groups``: the arm moves the arm and the palm."""
-    return tuple("arm" if g in (ARM, PALM) else FINGERS[g - 2] for g in groups)
+    return tuple("arm" if g in (ARM, PALM) else fingers[g - 2] for g in groups)
 
 
 @dataclass(frozen=True)
@@ -87,29 +92,34 @@ class Scene:
 
     def __init__(self, world: World, textures: bool = True) -> None:
         self.world = world
+        profile = profile_at(world.robot)
         load = load_model if textures else load_untextured
-        self.model = model = load(world.model_path)
+        self.model = model = load(world.model_path, profile)
         self.data = data = mujoco.MjData(model)
         mujoco.mj_kinematics(model, data)  # the objects' poses: all the preview reads
         believed = {
             model.body(b).name: (data.xpos[b].copy(), data.xmat[b].reshape(3, 3).copy())
             for b in scene_bodies(model, world)
         }
-        self.robot = robot = MujocoRobot(model, data)
+        self.robot = robot = MujocoRobot(model, data, profile=profile)
         self.index = robot.index
-        ik = LeanArmIK()  # the run's IK to rounding, faster; the fingers' on the same model
+        rest_hand(model, data, robot.index)
+        robot.hand_target = robot.measured_hand()
+        self.fingers = tuple(f.name for f in profile.fingers)
+        self._part = part_names(self.fingers)
+        ik = LeanArmIK(profile=profile)  # the run's IK to rounding, faster; the fingers' likewise
         pos, rot = home_pose(world, believed)
         # The start pose by the run's own IK: where a statement planned from it starts is
         # then the run's to the bit (what a target out of reach reports depends on that).
         what = "the start pose (location 'home')"
-        home = ArmIK(ik.model).solve(pos, rot, np.array(ARM_HOME), what)
+        home = ArmIK(ik.model, profile).solve(pos, rot, np.array(profile.arm.home), what)
         robot.arm_target = home
-        self.ctx = Context(robot, robot.view, world, believed, ik, FingerIKOnDemand(ik.model))
+        fingers_ik = FingerIKOnDemand(ik.model, profile)
+        self.ctx = Context(robot, robot.view, world, believed, ik, fingers_ik)
         self.parts = parts = Parts.of(model, robot.index)
-        names = [model.body(b).name for b in range(model.nbody)]
         group = np.where(parts.arm, ARM, np.where(parts.robot, PALM, -1))
-        for f, finger in enumerate(FINGERS):
-            mine = np.array([names[b].startswith(f"hand_{finger}_") for b in model.geom_bodyid])
+        for f, finger in enumerate(profile.fingers):
+            mine = np.isin(model.geom_bodyid, finger_bodies(model, finger.joints))
             group[mine & parts.robot] = finger_group(f)
         self.group = group
         self._groups: list[int] = group.tolist()
@@ -126,6 +136,9 @@ class Scene:
         self._hand = b""  # the hand set-points in qpos
         self.pose()
 
+    def _effectors(self, *groups: int) -> tuple[str, ...]:
+        return effectors_of(self.fingers, *groups)
+
     # -- posing ------------------------------------------------------------------------------------
     def pose(self) -> None:
         """Put the robot at its set-points (carrying what it holds) and find the contacts."""
@@ -136,7 +149,8 @@ class Scene:
         qpos[ix.arm_qpos] = np.minimum(np.maximum(r.arm_target, arm_lo), arm_hi)
         hand = r.hand_target.tobytes()
         if hand != self._hand:  # the hand seldom moves
-            qpos[ix.hand_qpos] = np.minimum(np.maximum(r.hand_target, hand_lo), hand_hi)
+            hand_q = np.minimum(np.maximum(r.hand_target, hand_lo), hand_hi)
+            qpos[ix.hand_qpos] = hand_q[ix.hand_bits]
             self._hand = hand
         mujoco.mj_kinematics(m, d)
         if self.held:
@@ -213,22 +227,29 @@ class Scene:
                 if ga == ARM:
                     text = f"the hand hits the arm ({pair})"
                 elif ga == PALM:
-                    text = f"the {_PART[gb]} runs into the palm ({pair})"
+                    text = f"the {self._part[gb]} runs into the palm ({pair})"
                 else:
-                    text = f"the {_PART[ga]} and the {_PART[gb]} collide ({pair})"
-                out.append(Hit(_effectors(ga, gb), ("self", _PART[ga], _PART[gb]), text, depth))
+                    text = f"the {self._part[ga]} and the {self._part[gb]} collide ({pair})"
+                out.append(
+                    Hit(
+                        self._effectors(ga, gb),
+                        ("self", self._part[ga], self._part[gb]),
+                        text,
+                        depth,
+                    )
+                )
                 continue
             other, pair = self._other(b), f"{self._name(a)} and {self._name(b)}"
             if ga == ARM:
                 kind, text = "arm", f"the arm hits {other} ({pair})"
             elif self.parts.fixed[b] and depth > FIXED_DEPTH:
-                kind, text = "fixed", f"the {_PART[ga]} presses into {other} ({pair})"
+                kind, text = "fixed", f"the {self._part[ga]} presses into {other} ({pair})"
             elif not self.parts.fixed[b] and depth > OBJECT_DEPTH:
-                kind, text = "object", f"the {_PART[ga]} pushes into {other} ({pair})"
+                kind, text = "object", f"the {self._part[ga]} pushes into {other} ({pair})"
             else:
                 continue
             part = "arm" if ga == ARM else "hand"  # one report per object, whichever finger
-            out.append(Hit(_effectors(ga), (kind, part, other), text, depth))
+            out.append(Hit(self._effectors(ga), (kind, part, other), text, depth))
         return out
 
     def _name(self, geom: int) -> str:

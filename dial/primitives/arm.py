@@ -40,7 +40,7 @@ LINE_TURN_STEP = np.radians(2.0)  # rad
 class Segment:
     """One piece of an arm motion: joint-interpolated, or a straight tool line.
 
-    ``waypoints`` (N + 1, 6): a line's joint configurations at u = k / N along it, from its
+    ``waypoints`` (N + 1, arm joints): a line's joint configurations at u = k / N along it, from its
     start to its goal; two rows (its ends) for a joint-interpolated segment.
     """
 
@@ -65,12 +65,12 @@ class Segment:
 
     @cached_property
     def steps(self) -> FloatArray:
-        """(N, 6): each waypoint's difference to the next (b - a, worked out once)."""
+        """(N, arm joints): each waypoint's difference to the next (b - a, worked out once)."""
         steps: FloatArray = self.waypoints[1:] - self.waypoints[:-1]
         return steps
 
     def at_array(self, u: FloatArray) -> FloatArray:
-        """(K, 6): :meth:`at` of each fraction, bit for bit."""
+        """(K, arm joints): :meth:`at` of each fraction, bit for bit."""
         last = len(self.waypoints) - 1
         x = np.minimum(1.0, np.maximum(0.0, u)) * last
         k = np.minimum(x.astype(np.intp), last - 1)
@@ -114,9 +114,14 @@ class Planner:
         turn = float(np.arccos(np.clip((np.trace(r0.T @ r1) - 1.0) / 2.0, -1.0, 1.0)))
         n = max(1, math.ceil(max(length / LINE_STEP, turn / LINE_TURN_STEP)))
         waypoints, turning = [self.q], Slerp(r0, r1)
+        q0 = self.q
         for k in range(1, n):
             u = k / n
-            waypoints.append(ik.track(p0 + (p1 - p0) * u, turning(u), waypoints[-1]))
+            # A redundant arm's goal, solved from afar, may hold its spare freedom elsewhere
+            # than the start (its posture task): the waypoints are drawn to the joints'
+            # interpolation, so that it moves evenly along the line, not in its last step.
+            guide = q0 + (q1 - q0) * u
+            waypoints.append(ik.track(p0 + (p1 - p0) * u, turning(u), waypoints[-1], guide=guide))
         waypoints.append(q1)
         cost = max(length / LINEAR_SPEED, turn / TURN_SPEED)
         self.segments.append(Segment(np.stack(waypoints), cost))
@@ -216,7 +221,8 @@ class ArmMotion(RobotPrimitive):
         return self.slots.arm_course(self._rows(np.array(beyond)))
 
     def _rows(self, p: FloatArray) -> FloatArray:
-        """(len(p), 6): :meth:`step`'s set-points at each progress in ``p``, bit for bit."""
+        """(len(p), arm joints): :meth:`step`'s set-points at each progress in ``p``, bit for
+        bit."""
         if len(self.segments) == 1:
             return self.segments[0].at_array(smooth_array(p / max(self.bounds[0], 1e-12)))
         ends = self._ends
@@ -224,7 +230,7 @@ class ArmMotion(RobotPrimitive):
         which = np.minimum(np.searchsorted(ends + 1e-12, p, side="left"), len(ends) - 1)
         starts = self._starts[which]
         u = smooth_array((p - starts) / np.maximum(ends[which] - starts, 1e-12))
-        rows = np.empty((len(p), 6))
+        rows = np.empty((len(p), len(self.q)))
         for j in range(int(which[0]), int(which[-1]) + 1):  # progress only grows
             rows[which == j] = self.segments[j].at_array(u[which == j])
         return rows

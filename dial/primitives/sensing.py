@@ -34,14 +34,14 @@ NO_BASELINE = (0.0,) * 16  # a force reading measured from zero: the differentia
 def contact_value(contact: Contact, snapshot: Snapshot, baseline: Sequence[float]) -> float:
     """The reading (m or N) a contact condition compares with its threshold, from the
     snapshot (:mod:`dial.robot.contact`); a force reading is the change from ``baseline``
-    (16 differentials). A dropped-out sensor reads 0, as the robot's guards read it."""
+    (16 joint loads). A dropped-out sensor reads 0, as the robot's guards read it."""
     kind, finger = contact.kind, contact.finger
     if (kind, finger) in snapshot.dropped:
         return 0.0
     if kind == "tactile":
         return tactile_reading(snapshot.tactile[finger])
     if kind == "force":
-        return force_reading(snapshot.tensions.tolist(), baseline, finger)
+        return force_reading(snapshot.differentials.tolist(), baseline, finger)
     return position_reading(snapshot.hand_target, snapshot.hand_q, finger)
 
 

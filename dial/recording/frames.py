@@ -11,10 +11,11 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from dial.backend.model import RobotIndex
+from dial.backend.model import RobotIndex, hand_angles, tactile_images, tendon_tensions
 from dial.recording.geometry import moving_bodies
 from dial.recording.task import TaskProbe
 from dial.robot.snapshot import FloatArray
+from dial.robots.profile import RobotProfile
 
 RECORD_HZ = 50.0  # frames per second of simulated time in a recording
 
@@ -23,8 +24,9 @@ RECORD_HZ = 50.0  # frames per second of simulated time in a recording
 class Batch:
     """``n`` frames: ``time_ns`` (n,) simulated ns; ``tick`` (n,); body poses in the world,
     ``pos`` (n, B, 3) m and ``quat`` (n, B, 4) (x, y, z, w) for the bodies ``Frames.bodies``;
-    ``joints`` (n, 16) rad, mask order; ``arm`` (n, 6) rad, PUMA joints 1-6; ``tensions``
-    (n, 32) N, tendon order; ``tactile`` (n, 4, 16, 16) m, finger, row, column; ``task``
+    ``joints`` (n, 16) rad, mask order; ``arm`` (n, A) rad, the arm's joints in order;
+    ``tensions`` (n, L) the hand's load readings (a tendon hand: its 32 tensions in N, tendon
+    order; else its joints' torques, N m); ``tactile`` (n, fingers, rows, columns) m; ``task``
     (n, S) the task's measurements (:class:`~dial.recording.task.TaskProbe`)."""
 
     time_ns: np.ndarray
@@ -44,19 +46,29 @@ class Batch:
 class Frames:
     """Collects frames from ``MjData`` until :meth:`take` hands them over."""
 
-    def __init__(self, model: mujoco.MjModel, probe: TaskProbe | None = None) -> None:
-        self.index = RobotIndex.from_model(model)
+    def __init__(
+        self,
+        model: mujoco.MjModel,
+        probe: TaskProbe | None = None,
+        profile: RobotProfile | None = None,
+    ) -> None:
+        self.index = ix = RobotIndex.from_model(model, profile)
         self.probe = probe
         self.bodies = moving_bodies(model)
-        self._tactile = [int(a) for a in self.index.tactile_sensors]
+        rows, cols = ix.profile.hand.taxels
+        self._tactile_shape = (len(ix.fingertip_sites), rows, cols)
+        loads = len(ix.load_sensors) or len(ix.hand_actuators)
+        # Where each field ends in a frame's flat row.
+        arm = 16 + len(ix.arm_qpos)
+        self._ends = (16, arm, arm + loads, arm + loads + int(np.prod(self._tactile_shape)))
         self._rows: list[tuple[int, int, FloatArray, FloatArray, FloatArray]] = []
 
     def capture(
         self, time: float, tick: int, data: mujoco.MjData, tensions: FloatArray | None = None
     ) -> None:
-        """Copy one frame; ``tensions`` (32,) N replaces the sensors' (a replay has no forces)."""
-        ix, sd = self.index, data.sensordata
-        tactile = np.concatenate([sd[a : a + 256] for a in self._tactile])
+        """Copy one frame; ``tensions`` replaces the load sensors' (a replay has no forces)."""
+        ix = self.index
+        tactile = tactile_images(data, ix).ravel()
         self._rows.append(
             (
                 round(time * 1e9),
@@ -65,9 +77,9 @@ class Frames:
                 data.xquat[self.bodies].copy(),
                 np.concatenate(
                     [
-                        data.qpos[ix.hand_qpos],
+                        hand_angles(data, ix),
                         data.qpos[ix.arm_qpos],
-                        sd[ix.tension_sensors] if tensions is None else tensions,
+                        tendon_tensions(data, ix) if tensions is None else tensions,
                         tactile,
                         self.probe.sample(data) if self.probe is not None else (),
                     ]
@@ -82,16 +94,17 @@ class Frames:
         rows, self._rows = self._rows, []
         quat = np.stack([r[3] for r in rows])
         flat = np.stack([r[4] for r in rows])
+        hand, arm, loads, tactile = self._ends
         return Batch(
             time_ns=np.array([r[0] for r in rows], dtype=np.int64),
             tick=np.array([r[1] for r in rows], dtype=np.int64),
             pos=np.stack([r[2] for r in rows]),
             quat=quat[..., [1, 2, 3, 0]],  # MuJoCo's (w, x, y, z) to rerun's (x, y, z, w)
-            joints=flat[:, :16],
-            arm=flat[:, 16:22],
-            tensions=flat[:, 22:54],
-            tactile=flat[:, 54:1078].reshape(-1, 4, 16, 16),
-            task=flat[:, 1078:],
+            joints=flat[:, :hand],
+            arm=flat[:, hand:arm],
+            tensions=flat[:, arm:loads],
+            tactile=flat[:, loads:tactile].reshape(-1, *self._tactile_shape),
+            task=flat[:, tactile:],
         )
 
     def __len__(self) -> int:

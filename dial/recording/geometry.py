@@ -13,6 +13,7 @@ import mujoco
 import numpy as np
 
 from dial.robot.snapshot import FloatArray
+from dial.robots.profile import RobotProfile
 
 SHOWN_GROUPS = 4  # geom groups 0-3 are drawn; 4 and up hold debug sites and markers
 KINDS = {
@@ -115,17 +116,35 @@ def body_names(model: mujoco.MjModel) -> list[str]:
     return entity_names(model, mujoco.mjtObj.mjOBJ_BODY, model.nbody, "body")
 
 
-GROUPS = (("puma_", "arm/"), ("hand_", "hand/"))  # body-name prefix -> entity group
+Groups = tuple[tuple[str, str], ...]  # body-name prefix -> entity group
+GROUPS: Groups = (("puma_", "arm/"), ("hand_", "hand/"))  # the first robot's
 
 
-def body_paths(model: mujoco.MjModel, objects: Mapping[str, str]) -> list[str]:
+def name_groups(robot: RobotProfile) -> Groups:
+    """A robot's groups, from the prefixes of its arm's and its hand's first joint names: the
+    word before the first ``_`` (``puma_``, ``hand_``; ``panda_``, ``allegro_``); none for a
+    name without one."""
+    groups = []
+    first = (robot.arm.joints[0], robot.fingers[0].joints[0])
+    for name, group in zip(first, ("arm/", "hand/"), strict=True):
+        head, sep, _ = name.partition("_")
+        if sep:
+            groups.append((head + sep, group))
+    return tuple(groups)
+
+
+def body_paths(
+    model: mujoco.MjModel, objects: Mapping[str, str], robot: RobotProfile | None = None
+) -> list[str]:
     """Each body's entity path under ``world``, readable on hover: ``arm/link2``,
-    ``hand/index_distal``, a scene object by its alias (``bulb``; ``objects`` maps aliases to
-    body names), ``scene/<body>`` for the rest, and ``scene/static`` for the world body."""
+    ``hand/index_distal`` (the robot's bodies, by its :func:`name_groups`; the first robot's
+    when None), a scene object by its alias (``bulb``; ``objects`` maps aliases to body
+    names), ``scene/<body>`` for the rest, and ``scene/static`` for the world body."""
+    groups = GROUPS if robot is None else name_groups(robot)
     alias = {body: name for name, body in objects.items()}
     paths = []
     for i, name in enumerate(body_names(model)):
-        group = next((g + name[len(p) :] for p, g in GROUPS if name.startswith(p)), None)
+        group = next((g + name[len(p) :] for p, g in groups if name.startswith(p)), None)
         paths.append("scene/static" if i == 0 else alias.get(name) or group or f"scene/{name}")
     return paths
 

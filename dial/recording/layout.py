@@ -29,8 +29,13 @@ RIGHT_SHARES = (1.3, 0.45, 1.0)  # scene, task, tactile and robot
 TACTILE_BOUNDS = ((-1.0, 59.0), (-1.0, 39.5))
 
 
-def blueprint(eye: tuple[Vec3, Vec3] | None, task: Sequence[tuple[str, str]]) -> rrb.Blueprint:
-    """The layout; ``eye`` (position, look target) in m, ``task`` (name, title) per series."""
+def blueprint(
+    eye: tuple[Vec3, Vec3] | None,
+    task: Sequence[tuple[str, str]],
+    loads: str = "tendons (N)",
+) -> rrb.Blueprint:
+    """The layout; ``eye`` (position, look target) in m, ``task`` (name, title) per series,
+    ``loads`` the title of the hand's load plots."""
     controls = None
     if eye is not None:
         controls = rrb.EyeControls3D(position=eye[0], look_target=eye[1], eye_up=(0.0, 0.0, 1.0))
@@ -51,7 +56,7 @@ def blueprint(eye: tuple[Vec3, Vec3] | None, task: Sequence[tuple[str, str]]) ->
     )
     robot = rrb.Tabs(
         _per_finger(HAND_JOINTS, "joints (rad)"),
-        _per_finger(TENDONS, "tendons (N)"),
+        _per_finger(TENDONS, loads),
         rrb.TimeSeriesView(origin=ARM_JOINTS, name="arm joints (rad)", plot_legend=_NO_LEGEND),
         name="robot",
     )

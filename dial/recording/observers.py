@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import mujoco
 
+from dial.backend.model import profile_at
 from dial.engine import RunResult, Watched
 from dial.engine.observe import every
 from dial.parser.lanes import LanePlan
@@ -33,8 +34,9 @@ def open_scene(
     """Send the scene and the layout to ``sink``; the frames to fill, with the task's probe."""
     probe = TaskProbe(model, world.criteria, world.objects)
     eye = workspace_eye(data, object_bodies(model, list(world.objects.values())))
-    sink.scene(model, data, title, eye, world.objects, probe.series, plan)
-    return Frames(model, probe)
+    profile = profile_at(world.robot)
+    sink.scene(model, data, title, eye, world.objects, probe.series, plan, profile)
+    return Frames(model, probe, profile)
 
 
 class Recorder:

@@ -16,7 +16,7 @@ from typing import Any
 import mujoco
 import numpy as np
 
-from dial.backend.model import load_model
+from dial.backend.model import load_model, profile_at
 from dial.errors import DialError
 from dial.recording.geometry import task_camera
 from dial.recording.lanes import LanePlan
@@ -43,7 +43,7 @@ def _replayed(
     world = load_world(
         path if path.is_absolute() and path.is_file() else resolve_scene(str(scene["scene"]), base)
     )
-    model = load_model(world.model_path)
+    model = load_model(world.model_path, profile_at(world.robot))
     data = mujoco.MjData(model)
     for name in world.objects.values():  # --perturb moved the fixed objects in the model
         body = model.body(name).id

@@ -4,15 +4,17 @@ recording or a live stream to a viewer.
 Entity paths:
 
 - ``world``: the scene, z up, every geometry solid. ``world/<body>`` holds a body's pose in
-  the world frame: ``world/arm/link2``, ``world/hand/index_distal``, a scene object by its
-  alias (``world/bulb``), ``world/scene/<body>`` for the rest; ``world/<body>/<geom>`` its
+  the world frame: ``world/arm/link2``, ``world/hand/index_distal`` (by the robot's name
+  prefixes), a scene object by its alias (``world/bulb``), ``world/scene/<body>`` for the
+  rest; ``world/<body>/<geom>`` its
   shapes (``world/hand/index_distal/pad``). ``world/contacts/guards/<n>`` where a guard
   stopped an effector (shown for two seconds), ``world/contacts/<set>`` the recorded contact
   points, ``world/fits/<set>`` fitted planes and superquadrics.
-- ``robot/hand/<finger>`` four joint angles (rad), ``robot/arm`` the six PUMA joints (rad),
-  ``robot/tendons/<finger>`` eight tendon tensions (N).
-- ``tactile/<finger>``: the 16x16 depths in mm, fingertip up, seen from the object, side by
-  side; ``tactile/key`` the depth colour scale and the plots' colours.
+- ``robot/hand/<finger>`` its joint angles (rad), ``robot/arm`` the arm's joints (rad),
+  ``robot/tendons/<finger>`` its joints' loads: a tendon hand's flexor and extensor tensions
+  (N), another hand's joint torques (N m).
+- ``tactile/<finger>``: the taxel depths in mm (16x16 on the bundled robots), fingertip up,
+  side by side; ``tactile/key`` the depth colour scale and the plots' colours.
 - ``task/<criterion>``: what the scene's criteria measure, over the run.
 - ``events/log``: a text log of starts, ends, contacts, warnings and the criteria.
 - ``<NN>_<event>``: the event lanes (:mod:`dial.recording.lanes`).
@@ -34,26 +36,30 @@ import mujoco
 import numpy as np
 import rerun as rr
 
-from dial.backend.model import FINGERS
+from dial.backend.model import FINGERS, default_profile
 from dial.errors import DialError
 from dial.recording import layout
 from dial.recording.frames import Batch
 from dial.recording.geometry import body_paths, moving_bodies, shapes, superquadric_mesh
 from dial.recording.lanes import STATE_COLORS, Lane, LanePlan, Lanes, Phase
 from dial.recording.rerun_shapes import SOLID, archetype, quat
+from dial.recording.styles import (
+    EXTENSOR_SHADE,
+    JOINT_COLORS,
+    JOINTS,
+    TASK_COLOR,
+    arm_series,
+    finger_series,
+    shade,
+)
 from dial.recording.task import Series
 from dial.recording.timeline import describe, when
 from dial.robot.snapshot import FloatArray
+from dial.robots.profile import RobotProfile
 
 APP_ID = "dial"
 TACTILE_MM = 1.0  # the colour scale's top: a firm press is 0.5-1 mm deep
 TACTILE_GAP = 3  # taxels between two fingertips' images
-JOINTS = ("abd", "mcp", "pip", "dip")
-JOINT_COLORS = ((255, 202, 40), (239, 83, 80), (102, 187, 106), (66, 165, 245))
-EXTENSOR_SHADE = 0.55  # an extensor is drawn in its joint's colour, darker
-ARM_COLORS = [(239, 83, 80), (255, 167, 38), (255, 238, 88), (102, 187, 106), (66, 165, 245)]
-ARM_COLORS += [(171, 71, 188)]
-TASK_COLOR = (255, 255, 255)
 GUARD_COLOR, POINT_COLOR, FIT_COLOR = (255, 80, 40), (40, 160, 255), (255, 200, 0, 140)
 GUARD_SHOWN_S = 2.0  # simulated seconds a guard's contact marker stays
 LEVELS = {"info": "INFO", "warn": "WARN", "error": "ERROR"}  # rerun's TextLogLevel
@@ -68,11 +74,6 @@ def _listening(port: int) -> bool:
     except OSError:
         return False
     return True
-
-
-def _shade(color: tuple[int, int, int], factor: float) -> tuple[int, int, int]:
-    r, g, b = (round(c * factor) for c in color)
-    return (r, g, b)
 
 
 class RerunSink:
@@ -109,6 +110,7 @@ class RerunSink:
         self._changes: dict[str, list[tuple[int, int, str]]] = {}  # lane: ns, tick, state
         self._points: dict[str, list[FloatArray]] = {}
         self._guards = 0
+        self._profile = default_profile()
 
     # -- once ---------------------------------------------------------------------------------
     def scene(
@@ -120,18 +122,22 @@ class RerunSink:
         objects: Mapping[str, str],
         task: Sequence[Series] = (),
         plan: LanePlan | None = None,
+        profile: RobotProfile | None = None,
     ) -> None:
         """Static geometry, series styles and the layout; ``data`` gives the fixed bodies'
-        poses, ``objects`` the scene's object aliases, ``plan`` the script's event lanes."""
+        poses, ``objects`` the scene's object aliases, ``plan`` the script's event lanes,
+        ``profile`` the robot (the default robot's when None)."""
         rec = self.rec
+        self._profile = default_profile() if profile is None else profile
         self.lanes = Lanes(plan)
         self.open_lanes(self.lanes)
         self._task = [f"{layout.TASK}/{s.name}" for s in task]
         rec.send_recording_name(title)
         titles = [(s.name, f"{s.label} ({s.unit})") for s in task]
-        rec.send_blueprint(layout.blueprint(eye, titles))
+        loads = "tendons (N)" if self._profile.hand.load == "tendon" else "joint torques (N m)"
+        rec.send_blueprint(layout.blueprint(eye, titles, loads))
         rec.log("world", rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
-        paths = [f"world/{p}" for p in body_paths(model, objects)]
+        paths = [f"world/{p}" for p in body_paths(model, objects, self._profile)]
         moving = set(moving_bodies(model).tolist())
         self._bodies = [paths[b] for b in sorted(moving)]
         for b in range(1, model.nbody):
@@ -147,22 +153,12 @@ class RerunSink:
     def _styles(self, task: Sequence[Series]) -> None:
         """Series names and colours: a joint's colour is the same in every finger's plot."""
         rec = self.rec
-        for finger in FINGERS:
-            names = [f"{finger} {j}" for j in JOINTS]
-            rec.log(
-                f"{layout.HAND_JOINTS}/{finger}",
-                rr.SeriesLines(names=names, colors=JOINT_COLORS),
-                static=True,
-            )
-            tendons = [f"{n} {k}" for n in names for k in ("flexor", "extensor")]
-            shades = [_shade(c, f) for c in JOINT_COLORS for f in (1.0, EXTENSOR_SHADE)]
-            rec.log(
-                f"{layout.TENDONS}/{finger}",
-                rr.SeriesLines(names=tendons, colors=shades),
-                static=True,
-            )
-        arm = [f"joint {i}" for i in range(1, 7)]
-        rec.log(layout.ARM_JOINTS, rr.SeriesLines(names=arm, colors=ARM_COLORS), static=True)
+        for finger, joints, loads in finger_series(self._profile):
+            for path, series in ((layout.HAND_JOINTS, joints), (layout.TENDONS, loads)):
+                line = rr.SeriesLines(names=series.names, colors=series.colors)
+                rec.log(f"{path}/{finger}", line, static=True)
+        arm = arm_series(self._profile)
+        rec.log(layout.ARM_JOINTS, rr.SeriesLines(names=arm.names, colors=arm.colors), static=True)
         for path, s in zip(self._task, task, strict=True):
             line = rr.SeriesLines(names=[f"{s.label} ({s.unit})"], colors=[TASK_COLOR], widths=2)
             rec.log(path, line, static=True)
@@ -176,7 +172,8 @@ class RerunSink:
         for (x, y), finger in zip(corners, FINGERS, strict=True):
             path = f"{layout.TACTILE}/{finger}"
             rec.log(path, rr.Transform3D(translation=[x, y, 0.0]), static=True)
-            image = rr.components.ImageFormat(16, 16, channel_datatype="F32")
+            rows, cols = self._profile.hand.taxels
+            image = rr.components.ImageFormat(cols, rows, channel_datatype="F32")
             rec.log(path, rr.DepthImage.from_fields(format=image, **depth), static=True)
         rec.log(
             f"{key}/fingers",
@@ -202,7 +199,7 @@ class RerunSink:
         )
         swatches = [
             *zip(JOINTS, JOINT_COLORS, strict=True),
-            ("extensor darker", _shade((200, 200, 200), EXTENSOR_SHADE)),
+            ("extensor darker", shade((200, 200, 200), EXTENSOR_SHADE)),
             ("guard contact", GUARD_COLOR),
             ("touched point", POINT_COLOR),
         ]
@@ -234,9 +231,13 @@ class RerunSink:
         for k, path in enumerate(self._bodies):
             poses = rr.Transform3D.columns(translation=batch.pos[:, k], quaternion=batch.quat[:, k])
             rec.send_columns(path, indexes=index, columns=poses)
+        per = 2 if self._profile.hand.load == "tendon" else 1  # load readings per joint
+        first = 0
         for f, finger in enumerate(FINGERS):
-            scalars(f"{layout.HAND_JOINTS}/{finger}", batch.joints[:, 4 * f : 4 * f + 4])
-            scalars(f"{layout.TENDONS}/{finger}", batch.tensions[:, 8 * f : 8 * f + 8])
+            joints = len(self._profile.fingers[f].joints)
+            scalars(f"{layout.HAND_JOINTS}/{finger}", batch.joints[:, 4 * f : 4 * f + joints])
+            scalars(f"{layout.TENDONS}/{finger}", batch.tensions[:, first : first + per * joints])
+            first += per * joints
             # Rows run proximal to distal: flip them to show the fingertip up. Depths in mm.
             pixels = np.ascontiguousarray(1000.0 * batch.tactile[:, f, ::-1, :], dtype=np.float32)
             rec.send_columns(

@@ -25,14 +25,12 @@ def tactile_reading(depths: FloatArray) -> float:
     return float(depths.item(depths.argmax()))
 
 
-def force_reading(tensions: Sequence[float], baseline: Sequence[float], finger: int) -> float:
-    """The largest change (N) of the finger's four tendon differentials (flexor minus extensor
-    tension) from ``baseline`` (the 16 differentials to measure from, mask order; zeros for
-    their value). ``tensions``: the 32 tendon tensions, flexor then extensor of each joint."""
-    return max(
-        abs(tensions[2 * k] - tensions[2 * k + 1] - baseline[k])
-        for k in range(4 * finger, 4 * finger + 4)
-    )
+def force_reading(loads: Sequence[float], baseline: Sequence[float], finger: int) -> float:
+    """The largest change (N) of the finger's four joint loads from ``baseline`` (the 16 loads
+    to measure from, mask order; zeros for their value). ``loads``: the 16 joint loads (N,
+    mask order): a tendon hand's flexor minus extensor tension, another hand's joint torque
+    over its lever (robot.toml ``hand.lever``), 0 for a joint the hand lacks."""
+    return max(abs(loads[k] - baseline[k]) for k in range(4 * finger, 4 * finger + 4))
 
 
 def position_reading(target: FloatArray, q: FloatArray, finger: int) -> float:

@@ -181,9 +181,15 @@ class ArmKinematics(Protocol):
         ...
 
     def track(
-        self, pos: FloatArray, rot: FloatArray, arm_q: FloatArray, iterations: int = 2
+        self,
+        pos: FloatArray,
+        rot: FloatArray,
+        arm_q: FloatArray,
+        iterations: int = 2,
+        guide: FloatArray | None = None,
     ) -> FloatArray:
-        """A few warm-started steps from ``arm_q`` toward the pose."""
+        """A few warm-started steps from ``arm_q`` toward the pose (a redundant arm's spare
+        freedom drawn towards ``guide``, if given)."""
         ...
 
 

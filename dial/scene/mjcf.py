@@ -2,8 +2,9 @@
 
 ``dial check`` uses this to report a malformed model, or a world object that names no body
 of it, before anything runs. Includes are followed as MuJoCo follows them (relative to the
-top-level file, or the robot's folder by name for a scene elsewhere), and so are models
-attached with a name prefix (``<attach model=... prefix=...>``).
+top-level file, or the robot's folder by name for a scene elsewhere, as dial's loader hands
+MuJoCo the robot's files), and so are models attached with a name prefix
+(``<attach model=... prefix=...>``).
 """
 
 from __future__ import annotations
@@ -20,8 +21,8 @@ _MAX_FILES = 200  # includes and attached models followed for one scene
 class _Reader:
     """The bodies of a model and of everything it includes or attaches."""
 
-    def __init__(self, top: Path) -> None:
-        self.dirs = (top.parent, models_dir() / ROBOT_DIR)
+    def __init__(self, top: Path, robot: Path) -> None:
+        self.dirs = (top.parent, robot)
         self.files = 0
         self.models: dict[str, tuple[str, Path]] = {}  # <asset><model>: name -> (file, referrer)
         self.attaches: list[tuple[str, str, str, Path]] = []  # model, body, prefix, referrer
@@ -80,12 +81,14 @@ class _Reader:
         return names
 
 
-def body_names(model: Path) -> frozenset[str]:
-    """Every named body of the MJCF model at ``model`` and what it includes or attaches.
+def body_names(model: Path, robot: Path | None = None) -> frozenset[str]:
+    """Every named body of the MJCF model at ``model`` and what it includes or attaches;
+    a file it names by bare name may be in the ``robot`` folder (default: the default
+    robot's).
 
     Raises :class:`~dial.scene.reader.WorldFileError` for a file that is missing or
     malformed, naming it and the place.
     """
-    reader = _Reader(model.resolve())
+    reader = _Reader(model.resolve(), models_dir() / ROBOT_DIR if robot is None else robot)
     names = reader.bodies(model.resolve())
     return frozenset(names | reader.attached())

@@ -34,7 +34,7 @@ def check_pushes(items: Sequence[Disturbance], world: World) -> None:
     pushes = [d for d in items if isinstance(d, Push)]
     if not pushes:
         return
-    bodies = body_names(world.model_path)
+    bodies = body_names(world.model_path, world.robot)
     for push in pushes:
         if push.body not in bodies:
             raise DisturbanceError(

@@ -8,6 +8,7 @@ from pathlib import Path
 from typing import Any
 
 from dial.errors import DialError
+from dial.robots.fields import key_problems, value_kind
 
 
 class WorldFileError(DialError, ValueError):
@@ -34,25 +35,19 @@ class Reader:
 
     def table(self, value: Any, key: str) -> Mapping[str, Any]:
         if not isinstance(value, Mapping):
-            raise self.error(key, f"expected a table, got {_kind(value)}")
+            raise self.error(key, f"expected a table, got {value_kind(value)}")
         return value
 
     def keys(
         self, table: Mapping[str, Any], key: str, required: Iterable[str], optional: Iterable[str]
     ) -> None:
         """Reject missing and unknown keys, listing the valid ones."""
-        required, optional = tuple(required), tuple(optional)
-        valid = ", ".join((*required, *optional))
-        for name in required:
-            if name not in table:
-                raise self.error(key, f"missing key '{name}' (keys: {valid})")
-        for name in table:
-            if name not in required and name not in optional:
-                raise self.error(_join(key, name), f"unknown key; valid keys: {valid}")
+        for name, message in key_problems(table, required, optional):
+            raise self.error(key if name is None else _join(key, name), message)
 
     def string(self, value: Any, key: str) -> str:
         if not isinstance(value, str):
-            raise self.error(key, f"expected a string, got {_kind(value)}")
+            raise self.error(key, f"expected a string, got {value_kind(value)}")
         return value
 
     def choice(self, value: Any, key: str, choices: Iterable[str], what: str) -> str:
@@ -65,40 +60,26 @@ class Reader:
     def number(self, value: Any, key: str) -> float:
         # bool is an int subclass; true/false is never a number here.
         if isinstance(value, bool) or not isinstance(value, int | float):
-            raise self.error(key, f"expected a number, got {_kind(value)}")
+            raise self.error(key, f"expected a number, got {value_kind(value)}")
         if not math.isfinite(value):
             raise self.error(key, f"expected a finite number, got {value}")
         return float(value)
 
     def integer(self, value: Any, key: str) -> int:
         if isinstance(value, bool) or not isinstance(value, int):
-            raise self.error(key, f"expected a whole number, got {_kind(value)}")
+            raise self.error(key, f"expected a whole number, got {value_kind(value)}")
         return value
 
     def vector(self, value: Any, key: str, n: int) -> tuple[float, ...]:
         if not isinstance(value, list) or len(value) != n:
-            raise self.error(key, f"expected a list of {n} numbers, got {_kind(value)}")
+            raise self.error(key, f"expected a list of {n} numbers, got {value_kind(value)}")
         return tuple(self.number(v, f"{key}[{i}]") for i, v in enumerate(value))
 
     def strings(self, value: Any, key: str) -> tuple[str, ...]:
         if not isinstance(value, list) or not value:
-            raise self.error(key, f"expected a non-empty list of strings, got {_kind(value)}")
+            raise self.error(key, f"expected a non-empty list of strings, got {value_kind(value)}")
         return tuple(self.string(v, f"{key}[{i}]") for i, v in enumerate(value))
 
 
 def _join(key: str, name: str) -> str:
     return f"{key}.{name}" if key else name
-
-
-def _kind(value: Any) -> str:
-    if isinstance(value, bool):
-        return f"a boolean ({str(value).lower()})"
-    if isinstance(value, str):
-        return f"a string ('{value}')"
-    if isinstance(value, int | float):
-        return f"a number ({value})"
-    if isinstance(value, list):
-        return f"a list of {len(value)}"
-    if isinstance(value, Mapping):
-        return "a table"
-    return type(value).__name__

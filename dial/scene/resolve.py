@@ -1,7 +1,9 @@
 """Where scenes live, and how ``@scene NAME_OR_PATH`` finds a world file.
 
-A scene is entered through its **world file** (TOML), which names the MJCF model it runs on.
-Bundled world files are ``<models_dir>/utah_hand_puma/worlds/<name>.toml``.
+A scene is entered through its **world file** (TOML), which names the MJCF model it runs on
+and the robot it binds the script to. Bundled world files live in each bundled robot's
+folder, ``<models_dir>/<robot>/worlds/<name>.toml``: the default robot's scenes by their
+name (``pour``), every robot's as ``<robot>/<name>`` (``allegro_panda/pour``).
 """
 
 from __future__ import annotations
@@ -11,8 +13,10 @@ from pathlib import Path
 
 from dial.instructions.scene_names import SceneNotFoundError
 from dial.resources import data_dir
+from dial.robots.profile import DEFAULT_ROBOT, FILE
 
-ROBOT_DIR = "utah_hand_puma"
+ROBOT_DIR = DEFAULT_ROBOT  # the default robot: a world file that names none runs on it
+ROBOT_FILE = FILE
 # The shared hand-pose file sits beside the world files but is not a scene.
 POSES_FILE = "hand_poses.toml"
 
@@ -22,14 +26,49 @@ def models_dir() -> Path:
     return data_dir("models")
 
 
-def worlds_dir() -> Path:
-    """Directory of the bundled world files."""
-    return models_dir() / ROBOT_DIR / "worlds"
+def worlds_dir(robot: str = ROBOT_DIR) -> Path:
+    """Directory of a bundled robot's world files (the default robot's by default)."""
+    return models_dir() / robot / "worlds"
+
+
+def bundled_robot_names() -> tuple[str, ...]:
+    """The bundled robots: the default first, then by name."""
+    names = sorted(p.parent.name for p in models_dir().glob(f"*/{ROBOT_FILE}"))
+    return tuple(sorted(names, key=lambda n: (n != ROBOT_DIR, n)))
+
+
+def _scenes(robot: str) -> list[str]:
+    return sorted(p.stem for p in worlds_dir(robot).glob("*.toml") if p.name != POSES_FILE)
 
 
 def bundled_scene_names() -> tuple[str, ...]:
-    """Names of the bundled scenes, sorted."""
-    return tuple(sorted(p.stem for p in worlds_dir().glob("*.toml") if p.name != POSES_FILE))
+    """Names of the bundled scenes: the default robot's, then ``robot/name`` for the others."""
+    names = _scenes(ROBOT_DIR)
+    for robot in bundled_robot_names():
+        if robot != ROBOT_DIR:
+            names += [f"{robot}/{name}" for name in _scenes(robot)]
+    return tuple(names)
+
+
+def bundled_world(name: str) -> Path | None:
+    """The world file of a bundled scene name (``pour``, ``allegro_panda/pour``, also
+    ``utah_hand_puma/pour``), or None."""
+    robot, _, scene = name.rpartition("/")
+    if robot and robot not in bundled_robot_names():
+        return None
+    if "/" in scene or scene in ("", POSES_FILE.removesuffix(".toml")):
+        return None
+    path = worlds_dir(robot or ROBOT_DIR) / f"{scene}.toml"
+    return path if path.is_file() else None
+
+
+def bundled_name(path: Path) -> str | None:
+    """The bundled scene name of a world file, or None if it is not a bundled scene."""
+    path = path.resolve()
+    for robot in bundled_robot_names():
+        if path.parent == worlds_dir(robot).resolve() and path.name != POSES_FILE:
+            return path.stem if robot == ROBOT_DIR else f"{robot}/{path.stem}"
+    return None
 
 
 def resolve_scene(scene: str, base_dir: Path) -> Path:
@@ -45,12 +84,12 @@ def resolve_scene(scene: str, base_dir: Path) -> Path:
         candidate = base_dir / candidate
     if candidate.is_file():
         return candidate
-    names = bundled_scene_names()
-    if scene in names:
-        return worlds_dir() / f"{scene}.toml"
+    bundled = bundled_world(scene)
+    if bundled is not None:
+        return bundled
     raise SceneNotFoundError(
         f"unknown scene '{scene}': neither a file (relative to the script) nor a bundled "
-        f"scene; bundled scenes: {', '.join(names)}"
+        f"scene; bundled scenes: {', '.join(bundled_scene_names())}"
     )
 
 
@@ -61,10 +100,9 @@ def scene_option(arg: str, option: str = "--scene") -> str:
     argument in it."""
     if Path(arg).is_file():
         return str(Path(arg).resolve())
-    names = bundled_scene_names()
-    if arg not in names:
+    if bundled_world(arg) is None:
         raise SceneNotFoundError(
             f"{option}: '{arg}' is neither a file nor a bundled scene; "
-            f"bundled scenes: {', '.join(names)}"
+            f"bundled scenes: {', '.join(bundled_scene_names())}"
         )
     return arg

@@ -51,7 +51,7 @@ class Depart:
 
 @dataclass(frozen=True)
 class Drive:
-    """``DRIVE J DEG``: turn PUMA joint ``joint`` (1-6) by ``angle`` rad, relative."""
+    """``DRIVE J DEG``: turn arm joint ``joint`` (1-based) by ``angle`` rad, relative."""
 
     line: int
     joint: int
@@ -114,8 +114,9 @@ def _length(text: str, lo: float, hi: float) -> float:
 
 
 def _joint(text: str) -> int:
-    if text not in ("1", "2", "3", "4", "5", "6"):
-        raise StatementError(f"expected a PUMA joint number from 1 to 6, got '{text}'")
+    # The arm's own count is checked where the robot is known (a world file's, a session's).
+    if len(text) != 1 or text not in "123456789":
+        raise StatementError(f"expected an arm joint number from 1 to 9, got '{text}'")
     return int(text)
 
 

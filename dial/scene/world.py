@@ -7,7 +7,6 @@ raises :class:`~dial.scene.reader.WorldFileError` naming the file and the key.
 from __future__ import annotations
 
 import math
-import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from difflib import get_close_matches
@@ -15,19 +14,34 @@ from pathlib import Path
 from types import MappingProxyType
 from typing import Any, Literal
 
+from dial.errors import DialError
 from dial.instructions.limits import drive_problem, hand_problem
 from dial.instructions.scene_names import SceneNames
 from dial.instructions.types import FINGERS
+from dial.robots.facts import RobotFacts, robot_facts
 from dial.scene.criteria import Criterion, parse_criterion
+from dial.scene.merge import load_merged, read_toml
 from dial.scene.mjcf import body_names
 from dial.scene.objects import Prior, parse_objects
 from dial.scene.reader import Reader, WorldFileError
-from dial.scene.resolve import resolve_scene
+from dial.scene.resolve import (
+    ROBOT_DIR,
+    ROBOT_FILE,
+    bundled_name,
+    bundled_robot_names,
+    models_dir,
+    resolve_scene,
+)
 from dial.scene.valii import NAME, Appro, Drive, Move, Statement, StatementError, parse_statement
 
 JOINTS: tuple[str, ...] = ("abd", "mcp", "pip", "dip")  # joint j of a finger: bit 4*f + j
 MAX_TURNS = 20.0  # a thread's turns before it lets go; more is a typo, not a bulb
 AXES: tuple[str, ...] = ("object", "world")
+
+
+def default_robot() -> Path:
+    """The folder of the robot a world file runs on when it names none."""
+    return (models_dir() / ROBOT_DIR).resolve()
 
 
 @dataclass(frozen=True)
@@ -83,7 +97,9 @@ class Program:
 @dataclass(frozen=True)
 class World:
     """Everything a world file declares. ``objects`` maps aliases to MuJoCo body names;
-    ``priors`` maps body names to what the file says is believed of them (if anything)."""
+    ``robot`` is the folder of the robot the scene binds scripts to (``robot = ...``, by
+    default the Utah hand on the PUMA); ``priors`` maps body names to what the file says is
+    believed of them (if anything)."""
 
     name: str
     path: Path
@@ -94,6 +110,7 @@ class World:
     programs: Mapping[str, Program]
     criteria: tuple[Criterion, ...]
     thread_turns: float | None = None  # [thread] turns: the model's threads let go after these
+    robot: Path = field(default_factory=default_robot)  # the robot's folder (robot.toml)
     priors: Mapping[str, Prior] = field(default_factory=lambda: MappingProxyType({}))
 
     def scene_names(self) -> SceneNames:
@@ -105,16 +122,17 @@ class World:
             programs=frozenset(self.programs),
             objects=frozenset(self.objects),
             anchored=frozenset(n for n, loc in self.locations.items() if loc.body is not None),
+            robot=robot_facts(self.robot),
         )
 
 
-_OPTIONAL_KEYS = ("poses", "locations", "programs", "criteria", "thread")
+_OPTIONAL_KEYS = ("robot", "poses", "locations", "programs", "criteria", "thread")
 
 
 def load_world(path: Path) -> World:
     """Load and validate a world file (following ``extends``)."""
     path = path.resolve()
-    data, _ = _load_merged(path, ())
+    data, _ = load_merged(path, ())
     reader = Reader(path)
     reader.keys(data, "", ["scene", "objects"], _OPTIONAL_KEYS)
     scene = reader.table(data["scene"], "scene")
@@ -123,20 +141,22 @@ def load_world(path: Path) -> World:
     if not model_path.is_file():
         raise reader.error("scene.model", f"no such model file: {model_path}")
     objects, priors = parse_objects(reader, data["objects"])
+    folder = _robot(reader, data["robot"]) if "robot" in data else default_robot()
+    robot = _facts(reader, folder)
     poses: dict[str, HandPose] = {}
     if "poses" in scene:
         shared = Path(reader.string(scene["poses"], "scene.poses"))
-        poses.update(_shared_poses(reader, shared))
+        poses.update(_shared_poses(reader, shared, robot))
     # The world file's poses win over the shared ones: a task tunes a standard pose (the
     # paper's "prelight") for its object under the standard name.
     for name, table in reader.table(data.get("poses", {}), "poses").items():
-        poses[name] = parse_pose(reader, name, table)
+        poses[name] = parse_pose(reader, name, table, robot)
     locations = {
         name: _location(reader, name, value, objects)
         for name, value in reader.table(data.get("locations", {}), "locations").items()
     }
     programs = {
-        name: _program(reader, name, value, locations)
+        name: _program(reader, name, value, locations, robot)
         for name, value in reader.table(data.get("programs", {}), "programs").items()
     }
     criteria = tuple(
@@ -144,7 +164,7 @@ def load_world(path: Path) -> World:
         for name, value in reader.table(data.get("criteria", {}), "criteria").items()
     )
     return World(
-        name=path.stem,
+        name=bundled_name(path) or path.stem,
         path=path,
         model_path=model_path,
         objects=MappingProxyType(objects),
@@ -153,6 +173,7 @@ def load_world(path: Path) -> World:
         programs=MappingProxyType(programs),
         criteria=criteria,
         thread_turns=_thread_turns(reader, data["thread"]) if "thread" in data else None,
+        robot=folder,
         priors=MappingProxyType(priors),
     )
 
@@ -170,7 +191,7 @@ def load_scene_names(scene: str, script_dir: Path) -> SceneNames:
 
 def check_bodies(world: World) -> None:
     """Raise :class:`WorldFileError` if the model is malformed or lacks an object's body."""
-    bodies = body_names(world.model_path)
+    bodies = body_names(world.model_path, world.robot)
     for alias, body in world.objects.items():
         if body not in bodies:
             close = get_close_matches(body, sorted(bodies), n=2)
@@ -180,35 +201,41 @@ def check_bodies(world: World) -> None:
             )
 
 
-def parse_pose(reader: Reader, name: str, table: Any) -> HandPose:
-    """One pose: per finger, ``[abd, mcp, pip, dip]`` in degrees, or a table of some of them."""
+def parse_pose(reader: Reader, name: str, table: Any, robot: RobotFacts | None = None) -> HandPose:
+    """One pose: per finger, ``[abd, mcp, pip, dip]`` in degrees (as many as the finger has
+    joints), or a table of some of them; each within the ``robot``'s joint range (default:
+    the default robot's)."""
+    robot = robot_facts(default_robot()) if robot is None else robot
     key = f"poses.{_name(reader, 'poses', name)}"
     table = reader.table(table, key)
     reader.keys(table, key, [], FINGERS)
     angles: dict[int, float] = {}
     for finger, value in table.items():
         fkey, base = f"{key}.{finger}", 4 * FINGERS.index(finger)
+        has = [j for j in JOINTS if base + JOINTS.index(j) in robot.hand_ranges]
         if isinstance(value, list):
-            joints = dict(zip(JOINTS, reader.vector(value, fkey, len(JOINTS)), strict=True))
+            joints = dict(zip(has, reader.vector(value, fkey, len(has)), strict=True))
         else:
             sub = reader.table(value, fkey)
-            reader.keys(sub, fkey, [], JOINTS)
+            reader.keys(sub, fkey, [], has)
             joints = {j: reader.number(v, f"{fkey}.{j}") for j, v in sub.items()}
         for joint, deg in joints.items():
-            problem = hand_problem(joint, math.radians(deg))
+            bit = base + JOINTS.index(joint)
+            problem = hand_problem(joint, math.radians(deg), robot.hand_ranges[bit])
             if problem is not None:
                 raise reader.error(f"{fkey}.{joint}", problem)
-            angles[base + JOINTS.index(joint)] = math.radians(deg)
+            angles[bit] = math.radians(deg)
     if not angles:
         raise reader.error(key, f"a pose must set at least one joint of {', '.join(FINGERS)}")
     return HandPose(name, MappingProxyType(dict(sorted(angles.items()))))
 
 
-def _shared_poses(world: Reader, path: Path) -> dict[str, HandPose]:
-    data = _read_toml(path, world)
+def _shared_poses(world: Reader, path: Path, robot: RobotFacts) -> dict[str, HandPose]:
+    data = read_toml(path, world)
     reader = Reader(path)
     reader.keys(data, "", ["poses"], [])
-    return {n: parse_pose(reader, n, t) for n, t in reader.table(data["poses"], "poses").items()}
+    poses = reader.table(data["poses"], "poses")
+    return {n: parse_pose(reader, n, t, robot) for n, t in poses.items()}
 
 
 def _location(reader: Reader, name: str, value: Any, objects: Mapping[str, str]) -> Location:
@@ -226,7 +253,13 @@ def _location(reader: Reader, name: str, value: Any, objects: Mapping[str, str])
     return Location(name, body, (x, y, z), (roll, pitch, yaw), "world" if world_axes else "object")
 
 
-def _program(reader: Reader, name: str, value: Any, locations: Mapping[str, Location]) -> Program:
+def _program(
+    reader: Reader,
+    name: str,
+    value: Any,
+    locations: Mapping[str, Location],
+    robot: RobotFacts,
+) -> Program:
     key = f"programs.{_name(reader, 'programs', name)}"
     text = reader.string(value, key)
     statements: list[Statement] = []
@@ -238,8 +271,10 @@ def _program(reader: Reader, name: str, value: Any, locations: Mapping[str, Loca
             raise reader.error(where, str(e)) from None
         # A stored DRIVE turning further than its joint's whole range overshoots wherever it
         # starts (a session, such as dial teach, checks a drive against the joint's angle).
-        if isinstance(statement, Drive) and (p := drive_problem(statement.joint, statement.angle)):
-            raise reader.error(where, p)
+        if isinstance(statement, Drive):
+            p = drive_problem(statement.joint, statement.angle, robot.arm_ranges, robot.arm_name)
+            if p is not None:
+                raise reader.error(where, p)
         if isinstance(statement, Move | Appro) and statement.location not in locations:
             valid = ", ".join(locations) or "(none)"
             raise reader.error(
@@ -250,6 +285,27 @@ def _program(reader: Reader, name: str, value: Any, locations: Mapping[str, Loca
     if not statements:
         raise reader.error(key, "a program needs at least one statement")
     return Program(name, tuple(statements))
+
+
+def _robot(reader: Reader, value: Any) -> Path:
+    """``robot``: a bundled robot's name, or its folder (made absolute by :func:`_load_merged`)."""
+    text = reader.string(value, "robot")
+    folder = Path(text) if Path(text).is_absolute() else models_dir() / text
+    if (folder / ROBOT_FILE).is_file():
+        return folder.resolve()
+    raise reader.error(
+        "robot",
+        f"no robot '{text}': neither a folder with a {ROBOT_FILE} nor a bundled robot; "
+        f"bundled robots: {', '.join(bundled_robot_names())}",
+    )
+
+
+def _facts(reader: Reader, folder: Path) -> RobotFacts:
+    """The robot's facts; a broken robot folder is this world file's problem at ``robot``."""
+    try:
+        return robot_facts(folder)
+    except DialError as e:
+        raise reader.error("robot", f"robot {folder.name}: {e}") from None
 
 
 def _thread_turns(reader: Reader, value: Any) -> float:
@@ -268,94 +324,3 @@ def _name(reader: Reader, table: str, name: str) -> str:
     if not NAME.match(name):
         raise reader.error(f"{table}.{name}", "invalid name: expected [A-Za-z_][A-Za-z0-9_]*")
     return name
-
-
-def _load_merged(path: Path, seen: tuple[Path, ...]) -> tuple[dict[str, Any], frozenset[Path]]:
-    """The file's data with ``extends`` applied, and every file that went into it.
-
-    Tables merge entry by entry, the child winning. ``extends`` names one world file or a
-    list of them, merged in order. An entry that two bases set differently is an error
-    unless the child sets it too, or the later base extends the earlier one (a refinement):
-    a silent winner would hide which definition a script gets. ``[scene] description`` is
-    only text and never conflicts. Paths in ``[scene]`` are made absolute against the file
-    that wrote them, so a world file may extend one in another directory (or a bundled
-    scene, by name).
-    """
-    reader = Reader(path)
-    if path in seen:
-        chain = " -> ".join(str(p) for p in (*seen, path))
-        raise reader.error("extends", f"extends cycle: {chain}")
-    data = _read_toml(path, Reader(seen[-1]) if seen else None)
-    scene = data.get("scene")
-    if isinstance(scene, dict):
-        for key in ("model", "poses"):
-            if isinstance(scene.get(key), str):
-                scene[key] = str((path.parent / scene[key]).resolve())
-    if "extends" not in data:
-        return data, frozenset({path})
-    value = data.pop("extends")
-    names = [value] if isinstance(value, str) else value
-    if not isinstance(names, list) or not names or not all(isinstance(n, str) for n in names):
-        raise reader.error("extends", "expected a world file (name or path) or a list of them")
-    merged: dict[str, Any] = {}
-    files = {path}
-    setter: dict[tuple[str, ...], Path] = {}  # each base entry -> the base that set it
-    mine = _leaves(data)
-    for name in names:
-        try:
-            base_path = resolve_scene(name, path.parent).resolve()
-        except LookupError as e:
-            raise reader.error("extends", str(e)) from None
-        base, ancestry = _load_merged(base_path, (*seen, path))
-        before = _leaves(merged)
-        for entry, leaf in _leaves(base).items():
-            clash = entry in before and before[entry] != leaf and entry not in mine
-            if clash and entry != ("scene", "description") and setter[entry] not in ancestry:
-                raise reader.error(
-                    ".".join(entry),
-                    f"set differently by {setter[entry].name} and {base_path.name}; "
-                    "set it in this file to choose",
-                )
-            setter[entry] = base_path
-        merged = _merge(merged, base)
-        files |= ancestry
-    return _merge(merged, data), frozenset(files)
-
-
-def _leaves(data: Mapping[str, Any]) -> dict[tuple[str, ...], Any]:
-    """Every entry of a world file (``("poses", "grip")``, ``("scene", "model")``), by key."""
-    out: dict[tuple[str, ...], Any] = {}
-    for key, value in data.items():
-        if isinstance(value, dict):
-            out.update({(key, name): entry for name, entry in value.items()})
-        else:
-            out[(key,)] = value
-    return out
-
-
-def _merge(base: dict[str, Any], child: Mapping[str, Any]) -> dict[str, Any]:
-    """Tables merge entry by entry; an entry (a pose, a location, a criterion) is replaced
-    whole, so a redefined location does not keep, say, the ``object`` of the one it replaces."""
-    out = dict(base)
-    for key, value in child.items():
-        if isinstance(value, dict) and isinstance(out.get(key), dict):
-            out[key] = {**out[key], **value}
-        else:
-            out[key] = value
-    return out
-
-
-def _read_toml(path: Path, referrer: Reader | None) -> dict[str, Any]:
-    try:
-        with path.open("rb") as f:
-            return tomllib.load(f)
-    except FileNotFoundError:
-        if referrer is not None:
-            raise referrer.error("", f"no such file: {path}") from None
-        raise WorldFileError(path, "", "no such file") from None
-    except tomllib.TOMLDecodeError as e:
-        raise WorldFileError(path, "", f"invalid TOML: {e}") from None
-    except UnicodeDecodeError as e:
-        raise WorldFileError(path, "", f"not UTF-8 text (byte {e.start}); TOML is UTF-8") from None
-    except OSError as e:
-        raise WorldFileError(path, "", f"cannot read it: {e.strerror or e}") from None

@@ -267,7 +267,7 @@ SPECS: dict[str, Spec] = {
         "move the tool in a straight line (mm) and turn it (deg), in the world or tool frame",
         _jog,
     ),
-    "drive": Spec("drive J DEG", "turn PUMA joint J (1-6) by DEG degrees", _valii("drive")),
+    "drive": Spec("drive J DEG", "turn arm joint J by DEG degrees", _valii("drive")),
     "finger": Spec(
         "finger F JOINT DEG  |  finger F ABD MCP PIP DIP",
         "turn one joint (abd, mcp, pip, dip) of finger F by DEG, or set all four (deg)",

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from dial.backend.model import RobotIndex
+from dial.backend.model import RobotIndex, hand_bodies
 
 FIXED_DEPTH = 0.002  # m: the hand may rest on the table, not press into it
 OBJECT_DEPTH = 0.005  # m: a touch is shallower; deeper is the arm driving through an object
@@ -35,7 +35,7 @@ class Parts:
         bodies = [model.body(b).name for b in range(model.nbody)]
         gbody = model.geom_bodyid
         robot = model.body_rootid[gbody] == root
-        hand = np.array([bodies[b].startswith("hand_") for b in gbody])
+        hand = np.isin(gbody, sorted(hand_bodies(model, index)))
         # An unnamed geom goes by its body's name (the hand's link geoms are unnamed).
         names = tuple(model.geom(g).name or bodies[gbody[g]] or "world" for g in range(model.ngeom))
         return cls(

@@ -182,11 +182,14 @@ class Session:
 
     def _check_drive(self, st: Drive, q: FloatArray) -> None:
         j = st.joint - 1
+        arm = self.sim.index.profile.arm.name
+        if j >= len(q):
+            raise TeachError(f"refused: the {arm} has joints 1 to {len(q)}, not {st.joint}")
         lo, hi = self.sim.arm_range[j]
         goal = q[j] + st.angle
         if not lo <= goal <= hi:
             raise TeachError(
-                f"refused: PUMA joint {st.joint} would go to {math.degrees(goal):.1f} deg, beyond "
+                f"refused: {arm} joint {st.joint} would go to {math.degrees(goal):.1f} deg, beyond "
                 f"its range {math.degrees(lo):.0f} to {math.degrees(hi):.0f} deg; the robot "
                 "stays where it was"
             )

@@ -17,7 +17,15 @@ import numpy as np
 
 from dial.backend.driver import MujocoRobot
 from dial.backend.ik import ArmIK, FingerIK
-from dial.backend.model import ARM_HOME, RobotIndex, hand_ctrl, load_model
+from dial.backend.model import (
+    RobotIndex,
+    hand_actuators,
+    hand_angles,
+    hand_ctrl,
+    load_model,
+    profile_at,
+    rest_hand,
+)
 from dial.geometry import location_pose, rpy_matrix, smooth
 from dial.primitives.arm import Segment
 from dial.primitives.context import Context
@@ -83,30 +91,34 @@ class Sim:
 
     def __init__(self, world: World, settle: bool = True) -> None:
         self.world = world
-        self.model = model = load_model(world.model_path)
+        profile = profile_at(world.robot)
+        self.model = model = load_model(world.model_path, profile)
         set_turns(model, world)
         self.data = data = mujoco.MjData(model)
-        self.index = ix = RobotIndex.from_model(model)
+        self.index = ix = RobotIndex.from_model(model, profile)
         self.parts = Parts.of(model, ix)
         self.threads = find_threads(model)
         self.substeps = max(1, round(CONTROL_PERIOD / model.opt.timestep))
         mujoco.mj_forward(model, data)
         believed = believed_poses(model, data, world)
-        self.ik = ArmIK()
+        self.ik = ArmIK(profile=profile)
         pos, rot = self.start_pose = home_pose(world, believed)
-        q = self.ik.solve(pos, rot, np.array(ARM_HOME), "the start pose (location 'home')")
+        home = np.array(profile.arm.home)
+        q = self.ik.solve(pos, rot, home, "the start pose (location 'home')")
         data.qpos[ix.arm_qpos] = q
+        rest_hand(model, data, ix)
         self.arm_target = q.copy()
-        self.hand_target = data.qpos[ix.hand_qpos].copy()
+        self.hand_target = hand_angles(data, ix)
         self.limp = np.zeros(16, dtype=bool)
         self.on_period: Callable[[], None] | None = None  # a live viewer's update
         self._apply()
         mujoco.mj_forward(model, data)
         # The planner of `dial run` reads the world, the IK and the joint ranges from here.
-        robot = MujocoRobot(model, data)
+        robot = MujocoRobot(model, data, profile=profile)
         beliefs = Beliefs(world, believed, initial(world, believed)[1])
-        self.ctx = Context(robot, robot.view, world, believed, self.ik, FingerIK(), beliefs=beliefs)
-        self.arm_range = robot.view.arm_range  # (6, 2) rad
+        fik = FingerIK(profile=profile)
+        self.ctx = Context(robot, robot.view, world, believed, self.ik, fik, beliefs=beliefs)
+        self.arm_range = robot.view.arm_range  # (arm joints, 2) rad
         self.hand_range = robot.view.hand_range  # (16, 2) rad, mask order
         if settle:
             self.run_for(START_SETTLE_S)
@@ -135,10 +147,10 @@ class Sim:
         return np.array(self.data.qpos[self.index.arm_qpos])
 
     def hand_q(self) -> FloatArray:
-        return np.array(self.data.qpos[self.index.hand_qpos])
+        return hand_angles(self.data, self.index)
 
     def tool(self) -> tuple[FloatArray, FloatArray]:
-        """The measured tool pose: ``hand_palm`` position (3,) m and rotation (3, 3)."""
+        """The measured tool pose: the tool site's position (3,) m and rotation (3, 3)."""
         site = self.index.tool_site
         return self.data.site_xpos[site].copy(), self.data.site_xmat[site].reshape(3, 3).copy()
 
@@ -151,8 +163,8 @@ class Sim:
     def _apply(self) -> None:
         ix, d = self.index, self.data
         d.ctrl[ix.arm_actuators] = self.arm_target
-        d.ctrl[ix.tendon_actuators] = hand_ctrl(
-            np.where(self.limp, d.qpos[ix.hand_qpos], self.hand_target)
+        d.ctrl[hand_actuators(ix)] = hand_ctrl(
+            np.where(self.limp, hand_angles(d, ix), self.hand_target), ix
         )
 
     def period(self) -> None:

@@ -18,7 +18,7 @@ from pathlib import Path
 from typing import Any
 
 from dial.errors import DialError
-from dial.scene.resolve import resolve_scene, worlds_dir
+from dial.scene.resolve import bundled_name, resolve_scene
 from dial.scene.world import World, load_world
 from dial.teach.worldfile import TableName, Taught, entry_names, new_file_text
 
@@ -57,7 +57,7 @@ def open_target(scene: str, into: str | None, cwd: Path) -> tuple[World, Target]
         return world, _existing(path)
     if not path.parent.is_dir():
         raise DialError(f"--into {into}: no such directory {path.parent}")
-    bundled = scene_path.parent == worlds_dir().resolve() and not Path(scene).suffix
+    bundled = bundled_name(scene_path) is not None and not Path(scene).suffix
     extends = scene if bundled else os.path.relpath(scene_path, path.parent)
     text = new_file_text(extends, scene, path.name)
     shared = _shared(scene_path, path)

@@ -80,7 +80,10 @@ def tune(
         print("dial: without --perturb, the trials at each tick are the same run", file=err)
 
     rows = summarise(results)
-    scene = f" in scene {Path(options.scene).stem}" if options.scene else ""
+    scene = ""
+    if options.scene:  # a world file by its name, a bundled scene as given ("allegro_panda/pour")
+        file = options.scene.endswith(".toml")
+        scene = f" in scene {Path(options.scene).stem if file else options.scene}"
     faults = f", {len(options.disturb)} disturbance(s)" if options.disturb else ""
     title = (
         f"{path}{scene}: {options.trials} trial{'s' if options.trials != 1 else ''} per tick, "

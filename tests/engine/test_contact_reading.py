@@ -20,7 +20,7 @@ from hypothesis import strategies as st
 
 from dial.backend.driver import MujocoRobot
 from dial.backend.guards import Readings
-from dial.backend.model import load_model
+from dial.backend.model import load_model, profile_at
 from dial.instructions.types import CONTACT_KINDS, FINGERS, Contact, ContactKind
 from dial.primitives.sensing import contact_value
 from dial.robot.contact import POSITION_LEVER
@@ -35,8 +35,9 @@ def _robot(scene: str) -> MujocoRobot:
     """The scene's robot (its model compiled once per test session)."""
     if scene not in _robots:
         world = load_world(resolve_scene(scene, worlds_dir()))
-        model = load_model(world.model_path)
-        _robots[scene] = MujocoRobot(model, mujoco.MjData(model))
+        profile = profile_at(world.robot)
+        model = load_model(world.model_path, profile)
+        _robots[scene] = MujocoRobot(model, mujoco.MjData(model), profile=profile)
     return _robots[scene]
 
 
@@ -48,7 +49,8 @@ def _definition(
     dropped: frozenset[tuple[str, int]],
 ) -> float:
     """DESIGN 3's readings, written plainly from the physics: the deepest taxel; the largest
-    change of the finger's tendon differentials; its joint error times the lever."""
+    change of the finger's joint loads (tendon differentials, or joint torques over the
+    profile's lever); its joint error times the lever."""
     if (kind, f) in dropped:
         return 0.0
     d, ix = robot.data, robot.index
@@ -57,8 +59,9 @@ def _definition(
         a = int(ix.tactile_sensors[f])
         return float(np.max(d.sensordata[a : a + 256]))
     if kind == "force":
-        tensions = d.sensordata[ix.tension_sensors]
-        change = tensions[0::2] - tensions[1::2] - np.array(baseline)
+        raw = d.sensordata[ix.load_sensors]
+        loads = raw[0::2] - raw[1::2] if ix.tendons else raw / ix.lever
+        change = loads - np.array(baseline)
         return float(np.abs(change[joints]).max())
     error = robot.hand_target[joints] - d.qpos[ix.hand_qpos][joints]
     return float(np.linalg.norm(error)) * POSITION_LEVER
@@ -78,7 +81,10 @@ def _randomize(robot: MujocoRobot, seed: int) -> tuple[list[float], frozenset[tu
     lo, hi = robot.view.hand_range.T
     d.qpos[ix.hand_qpos] = rng.uniform(lo, hi)
     robot.hand_target = rng.uniform(lo - 0.1, hi + 0.1)
-    d.sensordata[ix.tension_sensors] = rng.uniform(0.0, 50.0, 32)
+    n = len(ix.load_sensors)
+    d.sensordata[ix.load_sensors] = (
+        rng.uniform(0.0, 50.0, n) if ix.tendons else rng.uniform(-0.7, 0.7, n)
+    )
     for a in ix.tactile_sensors:
         touched = rng.random(256) < rng.choice([0.0, 0.05, 0.5])
         d.sensordata[a : a + 256] = np.where(touched, rng.uniform(0.0, 0.003, 256), 0.0)

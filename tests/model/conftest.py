@@ -73,7 +73,30 @@ def at_home(index: RobotIndex) -> Callable[[mujoco.MjModel], mujoco.MjData]:
     return lambda model: _at_home(model, index)
 
 
-def _rotation(axis: int, angle: float) -> np.ndarray:
+def pose_errors(
+    model: mujoco.MjModel, data: mujoco.MjData, site: int, expected: np.ndarray
+) -> tuple[float, float]:
+    """Position (m) and angle (deg) between a site's frame, after ``mj_kinematics``, and the
+    4x4 ``expected`` pose."""
+    mujoco.mj_kinematics(model, data)
+    position = float(np.linalg.norm(data.site_xpos[site] - expected[:3, 3]))
+    relative = data.site_xmat[site].reshape(3, 3).T @ expected[:3, :3]
+    angle = np.arccos(np.clip((np.trace(relative) - 1.0) / 2.0, -1.0, 1.0))
+    return position, float(np.degrees(angle))
+
+
+def hold_drift(model: mujoco.MjModel, data: mujoco.MjData, site: int, steps: int = 1000) -> float:
+    """How far (m) a site wanders while the model steps ``steps`` times from ``data``."""
+    mujoco.mj_forward(model, data)
+    start = data.site_xpos[site].copy()
+    drift = 0.0
+    for _ in range(steps):
+        mujoco.mj_step(model, data)
+        drift = max(drift, float(np.linalg.norm(data.site_xpos[site] - start)))
+    return drift
+
+
+def rotation(axis: int, angle: float) -> np.ndarray:
     c, s = np.cos(angle), np.sin(angle)
     i, j = [k for k in range(3) if k != axis]
     rot = np.eye(3)
@@ -94,7 +117,7 @@ def pad_plate(model: mujoco.MjModel, index: RobotIndex) -> PlateBuilder:
         body = model.body(f"hand_{finger}_distal").id
         frame = home.xmat[body].reshape(3, 3)
         # Rx(-pitch) swings +z (distal) towards -y (the pad); Rz(roll) swings +x towards +y.
-        plate = frame @ _rotation(0, -pitch) @ _rotation(2, roll)
+        plate = frame @ rotation(0, -pitch) @ rotation(2, roll)
         face = home.xpos[body] + frame @ np.array([0.0, -PAD_Y - gap, PLATE_Z])
         centre = face + plate @ np.array([0.0, -PLATE_HALF[1], 0.0])
         quat = np.zeros(4)

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from dial.backend.model import ARM_HOME, RobotIndex
+from tests.model.conftest import pose_errors
 
 # Standard (distal) DH table of the PUMA 560: (d, a, alpha) per joint, theta_i = q_i.
 DH = [
@@ -56,13 +57,9 @@ def test_flange_matches_dh_at_random_configurations(
     for _ in range(200):
         q = rng.uniform(limits[:, 0], limits[:, 1])
         data.qpos[index.arm_qpos] = q
-        mujoco.mj_kinematics(model, data)
-        expected = dh_forward(q)
-        position_error = np.linalg.norm(data.site_xpos[flange] - expected[:3, 3])
-        relative = data.site_xmat[flange].reshape(3, 3).T @ expected[:3, :3]
-        angle_error = np.arccos(np.clip((np.trace(relative) - 1.0) / 2.0, -1.0, 1.0))
+        position_error, angle_error = pose_errors(model, data, flange, dh_forward(q))
         assert position_error < 1e-3, (q, position_error)
-        assert np.degrees(angle_error) < 0.1, (q, np.degrees(angle_error))
+        assert angle_error < 0.1, (q, angle_error)
 
 
 def test_base_stands_on_the_floor_at_the_origin(model: mujoco.MjModel) -> None:

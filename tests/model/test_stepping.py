@@ -17,6 +17,7 @@ from dial.backend.model import (
     hand_ctrl,
     load_model,
 )
+from tests.model.conftest import hold_drift
 
 # Arm holding configurations (rad): home, and stretched out horizontally, where gravity loads
 # the shoulder most.
@@ -89,10 +90,4 @@ def test_arm_holds_its_pose_under_gravity(
     data = mujoco.MjData(model)
     data.qpos[index.arm_qpos] = HOLDS[pose]
     data.ctrl[index.arm_actuators] = HOLDS[pose]
-    mujoco.mj_forward(model, data)
-    start = data.site_xpos[index.tool_site].copy()
-    drift = 0.0
-    for _ in range(1000):
-        mujoco.mj_step(model, data)
-        drift = max(drift, float(np.linalg.norm(data.site_xpos[index.tool_site] - start)))
-    assert drift < 1e-3
+    assert hold_drift(model, data, index.tool_site) < 1e-3

@@ -11,12 +11,14 @@ import pytest
 
 from dial.backend.model import (
     FINGERS,
-    HAND_JOINTS,
     RobotIndex,
+    default_profile,
     hand_ctrl,
     tendon_differentials,
     tendon_tensions,
 )
+
+HAND_JOINTS = tuple(j for finger in default_profile().fingers for j in finger.joints)
 
 # At rest with nothing touching, the differential only holds numerical residue (the limit
 # is 50 N): this bounds it.
@@ -41,10 +43,10 @@ def test_sixteen_hinges_and_thirty_two_tendon_actuators(
             adr = model.tendon_adr[tendon]
             assert model.tendon_num[tendon] == 1
             assert model.joint(model.wrap_objid[adr]).name == joint
-            assert model.wrap_prm[adr] == sign * index.moment_arm
+            assert model.wrap_prm[adr] == sign * index.lever
     np.testing.assert_array_equal(model.actuator_forcerange[index.tendon_actuators], [[0, 50]] * 32)
-    assert index.tension_limit == 50.0
-    assert index.moment_arm == 0.008
+    assert index.load_limit == 50.0
+    assert index.lever == 0.008
 
 
 def test_hand_ctrl_checks_its_shape() -> None:
@@ -66,7 +68,7 @@ def test_tensions_never_negative_under_noisy_control(
         mujoco.mj_step(model, data)
         tensions = tendon_tensions(data, index)
         assert tensions.min() >= 0.0
-        assert tensions.max() <= index.tension_limit
+        assert tensions.max() <= index.load_limit
         slack += int((tensions == 0.0).sum())
         taut += int((tensions > 0.0).sum())
     # The noise is strong enough to exercise both limits of the servo.
@@ -126,4 +128,4 @@ def test_catalogue_tension_limit_matches_the_model() -> None:
     from dial.backend.model import RobotIndex, load_model
     from dial.instructions.grasp_force import TENDON_TENSION_LIMIT
 
-    assert RobotIndex.from_model(load_model()).tension_limit == TENDON_TENSION_LIMIT
+    assert RobotIndex.from_model(load_model()).load_limit == TENDON_TENSION_LIMIT

@@ -7,11 +7,12 @@ from pathlib import Path
 
 import pytest
 
-from dial.backend.model import load_model
+from dial.backend.model import load_model, profile_at
 from dial.errors import ScriptError
 from dial.parser import check_text
-from dial.scene import bundled_scene_names, load_scene_names, load_world, models_dir, worlds_dir
+from dial.scene import bundled_scene_names, load_scene_names, load_world, models_dir
 from dial.scene.mjcf import body_names
+from dial.scene.resolve import bundled_world
 
 from .conftest import write
 
@@ -21,8 +22,8 @@ SCRIPT = '@scene w.toml\n% go puma_command "moves above_block"\n\ngo #\n'
 
 @pytest.mark.parametrize("name", bundled_scene_names())
 def test_body_names_are_those_mujoco_compiles(name: str) -> None:
-    world = load_world(worlds_dir() / f"{name}.toml")
-    model = load_model(world.model_path)
+    world = load_world(bundled_world(name))
+    model = load_model(world.model_path, profile_at(world.robot))
     compiled = {model.body(i).name for i in range(model.nbody)} - {"world"}
     assert body_names(world.model_path) == compiled
 

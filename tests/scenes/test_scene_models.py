@@ -7,9 +7,10 @@ import mujoco
 import numpy as np
 import pytest
 
-from dial.backend.model import load_model
+from dial.backend.model import load_model, profile_at
 from dial.scene import bundled_scene_names, load_world, worlds_dir
 from dial.scene.evaluate import evaluate
+from dial.scene.resolve import bundled_world
 from dial.scene.thread import find_threads
 
 from ..conftest import ROOT
@@ -45,9 +46,9 @@ def test_scene_steps_2s_under_noisy_control_without_warnings(name: str) -> None:
 
 @pytest.mark.parametrize("name", bundled_scene_names())
 def test_world_file_names_exist_in_the_model(name: str) -> None:
-    world = load_world(worlds_dir() / f"{name}.toml")
+    world = load_world(bundled_world(name))
     model = mujoco.MjModel.from_xml_path(str(world.model_path))
-    model.site("hand_palm")  # the tool frame of every location
+    model.site(profile_at(world.robot).arm.tool_site)  # the tool frame of every location
     for body in world.objects.values():
         model.body(body)
     for criterion in world.criteria:

@@ -35,7 +35,7 @@ def test_statements(text: str, statement: object) -> None:
         ("APPRO home", "expected 'APPRO LOCATION DISTANCE', got 'APPRO home'"),
         ("MOVE 9lives", "expected a location name"),
         ("APPRO home -0.1", "distance -0.1 is out of range: expected 0 m to 1 m"),
-        ("DRIVE 0 10", "expected a PUMA joint number from 1 to 6, got '0'"),
+        ("DRIVE 0 10", "expected an arm joint number from 1 to 9, got '0'"),
         ("DRIVE 6 400", "angle 400 is out of range: expected -360 deg to 360 deg"),
         ("DRIVE 6 ten", "expected an angle in deg"),
     ],

@@ -43,12 +43,17 @@ PAPER_PROGRAMS = {
     "lightbulb": {"to_bulb", "lower_to_bulb", "twist_wrist", "twist_CW", "retract_arm"},
     "pour": {"get_top", "lift_top", "to_grasp", "pour", "retract_arm"},
 }
+# The quarter turns lightbulb.dial and pour.dial ask of the arm's last joint (the PUMA's joint
+# 6), as world programs so that the scripts run on another arm.
+TURNS = {"lightbulb": {"turn_probe", "turn_back"}, "pour": {"turn_wrist", "turn_back"}}
 PAPER_POSES = {"open_hand", "prelight", "unscrew", "ungrasp", "point", "prepit"}
 
 
 def test_models_dir_is_the_checkout_models_folder() -> None:
     assert (models_dir() / "utah_hand_puma" / "objects_pour.xml").is_file()
-    assert bundled_scene_names() == SCENES
+    names = bundled_scene_names()
+    assert names[: len(SCENES)] == SCENES  # the first robot's, by name; then the others'
+    assert all(n.startswith("allegro_panda/") for n in names[len(SCENES) :])
 
 
 @pytest.mark.parametrize("name", SCENES)
@@ -68,7 +73,7 @@ def test_load_scene_names_reports_masks_locations_programs() -> None:
     assert names.poses["ungrasp"] == 0xEEEF  # flexion, and the index abducts with the middle
     assert names.poses["point_down"] == 0x000F
     assert "above_bulb" in names.locations
-    assert names.programs == PAPER_PROGRAMS["lightbulb"]
+    assert names.programs == PAPER_PROGRAMS["lightbulb"] | TURNS["lightbulb"]
 
 
 def test_scene_path_wins_over_bundled_name(tmp_path: Path) -> None:
@@ -166,7 +171,7 @@ def _world(tmp_path: Path, body: str) -> Path:
             '[programs]\np = "JUMP 3"',
             "programs.p line 1: unknown command 'JUMP'; valid commands: MOVE",
         ),
-        ('[programs]\np = "DRIVE 7 10"', "expected a PUMA joint number from 1 to 6, got '7'"),
+        ('[programs]\np = "DRIVE 7 10"', "the PUMA has joints 1 to 6, not 7"),
         ('[programs]\np = "DEPART 5"', "distance 5 is out of range: expected -1 m to 1 m"),
         ('[programs]\np = "DEPART 3N"', "unit 'N' is not a length unit"),
         ('[programs]\np = "; nothing"', "programs.p: a program needs at least one statement"),
@@ -197,7 +202,7 @@ def _world(tmp_path: Path, body: str) -> Path:
             '[criteria.c]\nkind = "upright"\nobject = "block"\ntilt = 3',
             "criteria.c.tilt: unknown key",
         ),
-        ("[bogus]", "bogus: unknown key; valid keys: scene, objects, poses"),
+        ("[bogus]", "bogus: unknown key; valid keys: scene, objects, robot, poses"),
         ("[thread]\nturns = true", "thread.turns: expected a number, got a boolean (true)"),
         ("[thread]", "thread: missing key 'turns' (keys: turns)"),
         ("[thread]\nturns = 2\npitch = 4", "thread.pitch: unknown key; valid keys: turns"),

@@ -56,7 +56,7 @@ def test_jog_one_axis() -> None:
         ("save pose 9lives", "expected a pose name"),
         ("save location x relative-to", "usage: save location NAME"),
         ("save location x axes=world", "axes=world applies to a location relative-to"),
-        ("drive 7 10", "expected a PUMA joint number from 1 to 6"),
+        ("drive 0 10", "expected an arm joint number from 1 to 9"),
         ("goto", "expected 'MOVE LOCATION'"),
         ("ex", "usage: ex PROGRAM"),
         ("where now", "usage: where"),
