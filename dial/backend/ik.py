@@ -207,7 +207,8 @@ class ArmIK(_Base):
         end. An arm without a posture task ignores it."""
         if not self.redundant:
             guide = None
-        key = memo_key(f"{self.MEMO}-track", pos, rot, arm_q, iterations, guide)
+        guided = () if guide is None else (guide,)  # a key's parts are what its file keeps
+        key = memo_key(f"{self.MEMO}-track", pos, rot, arm_q, iterations, *guided)
         known = self.memo.get(key)
         if isinstance(known, np.ndarray):
             return known.copy()

@@ -111,10 +111,12 @@ def test_a_solve_from_the_file_is_the_solve_to_the_bit(cache: Path) -> None:
     solver.memo.save()
     again = memo.Memo(solver.memo.fingerprint)  # a later process: this file, no solves
     assert solver.memo.fingerprint is not None
-    assert np.asarray(again.get(memo.memo_key("arm-solve", pos, rot, home))).tobytes() == (
-        fresh.tobytes()
-    )
-    tracked = [again.get(memo.memo_key("arm-track", goal, rot, fresh, 2)) for goal in goals]
+    assert np.asarray(
+        again.get(memo.memo_key(f"{solver.MEMO}-solve", pos, rot, home))
+    ).tobytes() == (fresh.tobytes())
+    tracked = [
+        again.get(memo.memo_key(f"{solver.MEMO}-track", goal, rot, fresh, 2)) for goal in goals
+    ]
     assert [np.asarray(t).tobytes() for t in tracked] == [q.tobytes() for q in line]
 
 
