@@ -49,6 +49,7 @@ def bench(script: str, pace: float, delays: list[float], folder: Path) -> list[s
     local = _json(_dial("run", script, "--quiet", "--json"))
     task = float(str(local["sim_time"]))
     rows = [f"{script:<16} local {task:7.2f} s (simulated time)"]
+    print(rows[0], flush=True)
     server = subprocess.Popen(
         _dial(
             "serve",
@@ -112,11 +113,20 @@ def main() -> None:
     p.add_argument("--scripts", default="pour,lightbulb")
     args = p.parse_args()
     delays = [float(d) for d in args.delays.split(",")]
+    commit = subprocess.run(
+        ["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"], capture_output=True, text=True
+    ).stdout.strip()
+    print(f"commit {commit or '?'}; load average {_load()} (1, 5, 15 min)")
     print(f"pace {args.pace:g}: link delays scaled by it, times divided by it")
     print("script           split  delay  task time  / local   end to end  bytes up  bytes down")
     with tempfile.TemporaryDirectory() as folder:
         for script in args.scripts.split(","):
             bench(f"{script}.dial", args.pace, delays, Path(folder))
+    print(f"load average at the end {_load()}: a loaded machine inflates every ratio")
+
+
+def _load() -> str:
+    return ", ".join(f"{x:.1f}" for x in os.getloadavg())
 
 
 if __name__ == "__main__":

@@ -20,7 +20,6 @@ from contextlib import contextmanager, suppress
 from pathlib import Path
 from typing import TYPE_CHECKING, TextIO
 
-from dial.disturb import Disturbance, parse_disturbance
 from dial.errors import DialError, OptionError
 from dial.instructions.scene_names import SceneNotFoundError
 from dial.parser.check import load as parse_and_check
@@ -33,6 +32,7 @@ if TYPE_CHECKING:  # trio and MuJoCo load only to run: `import dial` and checkin
     from dial.dataset.plan import Request
     from dial.dataset.writer import DatasetWriter
     from dial.debug import Break, Console
+    from dial.disturb import Disturbance
     from dial.engine import Observer, RunResult
     from dial.engine.state import StateFile
     from dial.scheduler.periods import Progress
@@ -141,7 +141,7 @@ def run(
     ``scene``). The keywords are described in docs/api.md. A stop signal (SIGINT, SIGTERM)
     ends the run cleanly: ``result.summary.interrupted``."""
     items, saved = _checked(tick, speed, seed, perturb, disturb, save_at, resume)
-    _check_watching(record, video, rerun, viewer)  # before the script: usage comes first
+    check_watching(record, video, rerun, viewer)  # before the script: usage comes first
     request = _dataset_request(dataset, fps, cameras)
     script = _script(script, scene)
     from dial import engine
@@ -200,6 +200,8 @@ def _checked(
     resume: str | Path | None,
 ) -> tuple[list[Disturbance], StateFile | None]:
     """The option checks that need no script: ranges, SPECs, the state files."""
+    from dial.disturb import parse_disturbance
+
     check_options(tick, speed, seed, perturb)
     if resume is not None and (tick is not None or speed != 1.0 or seed or perturb or disturb):
         raise OptionError(
@@ -268,6 +270,8 @@ def _pausing(
     script: Script, breaks: Sequence[str], step: bool, console: Console | None
 ) -> tuple[list[Break], Console | None]:
     """The breakpoints, and where a paused run reads commands (a terminal, else stdin)."""
+    if not (breaks or step):  # the debugger loads only for a run that pauses
+        return [], console
     from dial.debug import LineConsole, TerminalConsole, parse_break
 
     stops = [parse_break(b, _event_names(script)) for b in breaks]
@@ -281,7 +285,7 @@ def _event_names(script: Script) -> set[str]:
     return {name for called in scripts_of(script) for name in called.events}
 
 
-def _check_watching(
+def check_watching(
     record: str | Path | None, video: str | Path | None, rerun: bool, viewer: bool
 ) -> None:
     """What can be known about ``record``, ``video``, ``rerun`` and ``viewer`` before a run."""

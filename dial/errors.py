@@ -71,6 +71,41 @@ def shorten(text: str, limit: int = 40) -> str:
 
 WINDOW = 100  # characters of a source line shown around a caret
 MAX_SHOWN = 50  # diagnostics rendered per file; the rest are counted
+MAX_PROBLEMS = 100  # problems found per file: there the check of the file stops
+
+
+@dataclass(frozen=True)
+class Cutoff(Diagnostic):
+    """Where the check of a file stopped, at its :data:`MAX_PROBLEMS`-th problem, as a
+    compiler stops after so many errors: how many lines it did not check."""
+
+    @staticmethod
+    def at(path: str, line: int, text: str) -> Cutoff:
+        """The check of ``path`` (whose text is ``text``) stopped at a problem on ``line``."""
+        lines = text.count("\n") + (not text.endswith("\n"))  # as the parser counts them
+        after = max(lines - line, 0)
+        message = (
+            f"too many problems: the check stopped at line {line} after {MAX_PROBLEMS}; "
+            f"{after} line{'s' if after != 1 else ''} after it {'were' if after != 1 else 'was'} "
+            "not checked"
+        )
+        return Cutoff(path, Span(line, 1, 1), message)
+
+
+class TooManyProblems(Exception):
+    """Raised inside the checker at a file's :data:`MAX_PROBLEMS`-th problem; the file's
+    check ends there (never seen outside :mod:`dial.parser`)."""
+
+
+def tally(found: int, diags: list[Diagnostic], path: str, line: int, text: str) -> int:
+    """``found``, the problems of the file at ``path`` so far, the latest on ``line``. At
+    :data:`MAX_PROBLEMS` the check of the file stops: its :class:`Cutoff` joins ``diags``,
+    and :class:`TooManyProblems` is raised (as it is beyond, where the check stopped)."""
+    if found >= MAX_PROBLEMS:
+        if found == MAX_PROBLEMS:
+            diags.append(Cutoff.at(path, line, text))
+        raise TooManyProblems
+    return found
 
 
 def _window(line: str, span: Span) -> tuple[str, int, int]:
@@ -94,15 +129,19 @@ def _window(line: str, span: Span) -> tuple[str, int, int]:
 class ScriptError(DialError):
     """A script (or a script it calls) has one or more problems.
 
-    ``diagnostics`` is sorted by file, line and column.
+    ``diagnostics`` is sorted by file, line and column: at most :data:`MAX_PROBLEMS` per
+    file. ``cutoffs`` says where the check of a file stopped at that many, if it did.
     """
 
     def __init__(self, diagnostics: list[Diagnostic] | tuple[Diagnostic, ...]) -> None:
-        self.diagnostics = tuple(sorted(diagnostics, key=lambda d: (d.path, d.span)))
+        found = sorted(diagnostics, key=lambda d: (d.path, d.span))
+        self.diagnostics = tuple(d for d in found if not isinstance(d, Cutoff))
+        self.cutoffs = {d.path: d for d in found if isinstance(d, Cutoff)}
         super().__init__(self.render())
 
     def render(self) -> str:
-        """Every diagnostic, at most :data:`MAX_SHOWN` per file, then how many more."""
+        """Every diagnostic, at most :data:`MAX_SHOWN` per file, then how many more, and
+        where the check of the file stopped if it did."""
         out: list[str] = []
         for path, group in groupby(self.diagnostics, key=lambda d: d.path):
             diags = list(group)
@@ -110,4 +149,6 @@ class ScriptError(DialError):
             more = len(diags) - MAX_SHOWN
             if more > 0:
                 out.append(f"{path}: {more} more problem{'s' if more != 1 else ''} not shown")
+            if path in self.cutoffs:
+                out.append(self.cutoffs[path].header)
         return "\n".join(out)

@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+import atexit
 import importlib.util
 import json
 import os
+import shutil
+import tempfile
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -16,6 +19,13 @@ if TYPE_CHECKING:
 ROOT = Path(__file__).resolve().parent.parent
 DATA = ROOT / "tests" / "data"
 UPDATE = os.environ.get("DIAL_UPDATE_GOLDEN") == "1"
+
+# The IK's cache (dial.robot.memo) of this session, and of the processes it starts: a
+# folder of its own, empty at the start, never the user's; removed at exit, after the memo
+# has written it (atexit runs the later registration first).
+if "DIAL_CACHE" not in os.environ:
+    os.environ["DIAL_CACHE"] = tempfile.mkdtemp(prefix="dial-test-cache-")
+    atexit.register(shutil.rmtree, os.environ["DIAL_CACHE"], True)
 
 
 def needs(extra: str, *modules: str) -> pytest.MarkDecorator:

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from dial.errors import MAX_SHOWN, WINDOW, ScriptError
+from dial.errors import MAX_PROBLEMS, MAX_SHOWN, WINDOW, ScriptError
 from dial.parser import TBlock, check_text, expand, load
 from dial.parser.fmt import format_text
 from dial.parser.show import render
@@ -58,14 +58,46 @@ def test_reproducers_are_caret_errors(text: str, header: str) -> None:
 def test_many_problems_on_one_line_print_a_window_and_a_count() -> None:
     with pytest.raises(ScriptError) as info:
         check_text("% g get_joints " + "y=1 " * 25_000 + "\n", "x.dial")
-    assert len(info.value.diagnostics) == 25_000
+    assert len(info.value.diagnostics) == MAX_PROBLEMS  # the check stops there (issue 26)
     out = info.value.render().splitlines()
-    assert len(out) == 3 * MAX_SHOWN + 1
-    assert out[-1] == f"x.dial: {25_000 - MAX_SHOWN} more problems not shown"
+    assert len(out) == 3 * MAX_SHOWN + 2
+    assert out[-2] == f"x.dial: {MAX_PROBLEMS - MAX_SHOWN} more problems not shown"
+    assert out[-1] == (
+        f"x.dial:1:1: too many problems: the check stopped at line 1 after {MAX_PROBLEMS}; "
+        "0 lines after it were not checked"
+    )
     assert max(len(line) for line in out) < WINDOW + 20
-    source, caret = out[-3], out[-2]
+    source, caret = out[-4], out[-3]
     assert source.startswith(" 1 | ...") and source.endswith("...")
     assert source[caret.index("^") :].startswith("y=1")
+
+
+def test_the_check_of_a_file_stops_at_its_hundredth_problem(tmp_path: Path) -> None:
+    """As compilers do (issue 26): syntax problems on 150 lines, then names in a callee."""
+    (tmp_path / "sub.dial").write_text(GO + "nope #\n" * 120)
+    main = tmp_path / "main.dial"
+    main.write_text(GO + "@call sub.dial\n" + "?\n" * 150 + "go #\n")
+    with pytest.raises(ScriptError) as info:
+        load(main)
+    with pytest.raises(ScriptError) as again:
+        load(main)
+    assert info.value.render() == again.value.render()  # deterministic
+    headers = [d.header for d in info.value.diagnostics]
+    assert len(headers) == MAX_PROBLEMS  # the parser stops: no callee is checked
+    assert headers[0].startswith(f"{main}:4:1: unexpected '?'")
+    assert headers[-1].startswith(f"{main}:103:1: unexpected '?'")
+    cutoff = info.value.cutoffs[str(main)]
+    assert cutoff.header == (
+        f"{main}:103:1: too many problems: the check stopped at line 103 after "
+        f"{MAX_PROBLEMS}; 51 lines after it were not checked"
+    )
+    assert info.value.render().endswith(cutoff.header)
+    main.write_text(GO + "@call sub.dial\n")  # the callee's own 120 problems: capped in it
+    with pytest.raises(ScriptError) as callee:
+        load(main)
+    assert len(callee.value.diagnostics) == MAX_PROBLEMS
+    assert list(callee.value.cutoffs) == [str(tmp_path / "sub.dial")]
+    assert callee.value.cutoffs[str(tmp_path / "sub.dial")].span.line == 102
 
 
 def test_a_line_of_100000_runs_checks() -> None:

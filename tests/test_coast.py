@@ -39,7 +39,7 @@ CASES: dict[str, tuple[str, dict[str, object]]] = {
 }
 
 
-def _run(text: str, paced: bool, options: Mapping[str, object]) -> object:
+def _run(text: str, paced: bool, options: Mapping[str, object], lag: float = 0.0) -> object:
     behaviours = options.get("behaviours")
     holds = options.get("holds")
     fault_at = options.get("fault_at")
@@ -50,6 +50,7 @@ def _run(text: str, paced: bool, options: Mapping[str, object]) -> object:
         behaviours=behaviours,  # type: ignore[arg-type]
         holds=holds,  # type: ignore[arg-type]
         fault_at=fault_at,  # type: ignore[arg-type]
+        lag=lag,
     )
 
 
@@ -66,6 +67,25 @@ def test_coasting_gives_the_periods_records_and_set_points_of_stepping(case: str
     assert coasted.robot.stops == stepped.robot.stops  # type: ignore[attr-defined]
     same, done = (replace(r.summary, error=str(r.summary.error)) for r in (stepped, coasted))  # type: ignore[attr-defined]
     assert done == same
+
+
+@pytest.mark.parametrize("case", list(CASES))
+def test_a_paced_run_behind_the_clock_coasts_through_the_periods_already_due(case: str) -> None:
+    """A robot that takes three periods' time to simulate one (a loaded machine) falls
+    behind a paced run's clock: it coasts through the periods whose time has passed, never
+    ahead of the clock, and gives what stepping gives."""
+    text, options = CASES[case]
+    stepped = _run(text, paced=True, options=options)
+    behind = _run(text, paced=True, options=options, lag=0.03)
+    assert behind.robot.coasts != []  # type: ignore[attr-defined]
+    assert behind.log.records == stepped.log.records  # type: ignore[attr-defined]
+    assert behind.robot.trace == stepped.robot.trace  # type: ignore[attr-defined]
+    assert behind.robot.holds_at == stepped.robot.holds_at  # type: ignore[attr-defined]
+    assert behind.robot.stops == stepped.robot.stops  # type: ignore[attr-defined]
+    assert behind.trio_time > 2 * stepped.trio_time  # type: ignore[attr-defined]
+    on_time = _run(text, paced=True, options=options, lag=0.005)  # faster than the clock
+    assert on_time.robot.coasts == []  # type: ignore[attr-defined]
+    assert on_time.log.records == stepped.log.records  # type: ignore[attr-defined]
 
 
 def test_a_coast_stops_at_the_period_a_monitor_fires() -> None:

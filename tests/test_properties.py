@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import pytest
 
 pytest.importorskip(
@@ -11,8 +13,10 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from dial.errors import ScriptError
-from dial.parser import check_text, parse
+from dial.parser import check_text, parse, words
+from dial.parser.ast import Param
 from dial.parser.fmt import format_text
+from dial.parser.words import WordError
 
 DEFINITIONS = [
     '% go puma_command "moves above"',
@@ -162,3 +166,19 @@ def test_fmt_is_idempotent_and_preserves_the_program(text: str) -> None:
     once = format_text(text, "prop.dial")
     assert format_text(once, "prop.dial") == once
     assert parse(once, "prop.dial") == before
+
+
+@given(st.text(alphabet=" \t=_aZ1é\u00a0\x1c"))
+def test_parameters_without_quotes_take_the_lean_path_to_the_same_words(text: str) -> None:
+    """The tokenizer's path for parameters without quotes (issue 26) against the general
+    one: the same parameters, words and spans, or the same error."""
+
+    def split(tokenize: Callable[[int, str, int], list[Param]]) -> object:
+        code = "% g get_joints " + text
+        try:
+            params = tokenize(1, code, 14)
+        except WordError as e:
+            return e.span, e.message, e.known
+        return [(p, p.span, [w.span for w in p.words], hash(p)) for p in params]
+
+    assert split(words._unquoted) == split(words._general)

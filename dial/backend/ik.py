@@ -5,20 +5,33 @@ velocities (22 for the Utah hand on the PUMA) whatever the scene holds. Solution
 warm-started from the last one: a straight-line move solves one waypoint per control
 period. The tool site, the task weights, a posture task for a redundant arm and the retry
 seeds are the robot profile's (``[arm.ik]`` of its ``robot.toml``).
+
+Every solution is memoized by its exact inputs (:mod:`dial.robot.memo`, also kept in the
+user's cache folder, in a file named after the model, the profile and the solver's code),
+and mink is imported, and its tasks set up, only when a solver first meets a problem that
+the memo does not hold: a run whose solves are all known never loads mink, qpsolvers or
+SciPy. Forward kinematics needs only MuJoCo.
 """
 
 from __future__ import annotations
 
-import mink
+import sys
+from functools import cached_property
+from typing import TYPE_CHECKING
+
 import mujoco
 import numpy as np
 
+from dial.backend.fingerprint import fingerprint
 from dial.backend.index import RobotIndex
 from dial.backend.model import default_profile, load_model
 from dial.errors import DialError
-from dial.robot.memo import SOLUTIONS, memo_key
+from dial.robot.memo import memo_for, memo_key
 from dial.robot.snapshot import FloatArray
 from dial.robots.profile import RobotProfile
+
+if TYPE_CHECKING:
+    import mink
 
 SOLVER = "daqp"
 DT = 0.01  # s: the differential step of one solve
@@ -42,20 +55,41 @@ class _Base:
         profile = default_profile() if profile is None else profile
         self.model = load_model(profile=profile) if model is None else model
         self.index = RobotIndex.from_model(self.model, profile)
-        self.config = mink.Configuration(self.model)
-        # Joints at 0 where 0 is out of their range (the Allegro's thumb base) start at the
-        # nearest limit: a configuration outside the limits has no feasible step.
+        self.robot = profile.name  # in the memo's keys: two robots may share a configuration
+        # The memo's file is named after the model, the profile (its IK settings are not in
+        # the model) and the solvers' code: this module and the solver class's own.
+        code = {
+            getattr(sys.modules[c.__module__], "__file__", None)
+            for c in type(self).__mro__
+            if c.__module__.startswith("dial.")
+        }
+        sources = [f for f in code if f is not None] + [str(profile.path)]
+        self.memo = memo_for(fingerprint(self.model, sources))
+        self._kinematics = mujoco.MjData(self.model)  # for fk, apart from mink's
+
+    @cached_property
+    def start(self) -> FloatArray:
+        """The model's reference configuration, with joints whose 0 is out of their range
+        (the Allegro's thumb base) at the nearest limit: a configuration outside the limits
+        has no feasible step."""
+        q: FloatArray = self.model.qpos0.copy()
         limited = self.model.jnt_limited.astype(bool)
-        q = self.config.q.copy()
-        adr, lo, hi = (
-            self.model.jnt_qposadr[limited],
-            self.model.jnt_range[limited, 0],
-            self.model.jnt_range[limited, 1],
-        )
-        q[adr] = np.clip(q[adr], lo, hi)
-        self.config.update(q)
-        self.limits = [mink.ConfigurationLimit(self.model)]
-        self.memo = profile.name  # solutions are memoised per robot
+        adr = self.model.jnt_qposadr[limited]
+        q[adr] = np.clip(q[adr], self.model.jnt_range[limited, 0], self.model.jnt_range[limited, 1])
+        return q
+
+    @cached_property
+    def config(self) -> mink.Configuration:
+        """mink's configuration, made when the first solve needs it."""
+        import mink  # a run whose solves are all memoized never loads it
+
+        return mink.Configuration(self.model, self.start)
+
+    @cached_property
+    def limits(self) -> list[mink.ConfigurationLimit]:
+        import mink
+
+        return [mink.ConfigurationLimit(self.model)]
 
     def _site(self, name: str) -> int:
         return int(mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_SITE, name))
@@ -65,40 +99,63 @@ class ArmIK(_Base):
     """Tool-frame IK over the arm's joints (with a posture task for the spare freedom of an
     arm of more than six)."""
 
-    MEMO = "arm"  # the memo's name for this solver's results
-
     def __init__(
         self, model: mujoco.MjModel | None = None, profile: RobotProfile | None = None
     ) -> None:
         super().__init__(model, profile)
-        self.MEMO = f"arm:{self.memo}"  # per robot: two arms may share a configuration
-        settings = self.index.profile.arm.ik
-        self.task = mink.FrameTask(
+        self.MEMO = f"arm:{self.robot}"  # the memo's name for this solver's results
+        self.settings = self.index.profile.arm.ik
+        self.redundant = self.settings.posture_cost > 0  # a posture task for the spare freedom
+        self.seeds = tuple(np.array(s, dtype=np.float64) for s in self.settings.seeds)
+
+    @cached_property
+    def task(self) -> mink.FrameTask:
+        import mink
+
+        return mink.FrameTask(
             self.index.profile.arm.tool_site,
             "site",
-            position_cost=settings.position_cost,
-            orientation_cost=settings.orientation_cost,
+            position_cost=self.settings.position_cost,
+            orientation_cost=self.settings.orientation_cost,
         )
-        self.tasks: list[mink.Task] = [self.task]
-        self.posture: mink.PostureTask | None = None
-        if settings.posture_cost > 0:
-            cost = np.zeros(self.model.nv)
-            cost[self.index.arm_dof] = settings.posture_cost
-            posture = mink.PostureTask(self.model, cost=cost)
-            target = self.config.q.copy()
-            target[self.index.arm_qpos] = settings.posture
-            posture.set_target(target)
-            self.tasks.append(posture)
-            self.posture, self.rest = posture, target
+
+    @cached_property
+    def rest(self) -> FloatArray:
+        """The posture task's target: the profile's arm posture, the hand at its start."""
+        target = self.start.copy()
+        target[self.index.arm_qpos] = self.settings.posture
+        return target
+
+    @cached_property
+    def posture(self) -> mink.PostureTask | None:
+        if not self.redundant:
+            return None
+        import mink
+
+        cost = np.zeros(self.model.nv)
+        cost[self.index.arm_dof] = self.settings.posture_cost
+        posture = mink.PostureTask(self.model, cost=cost)
+        posture.set_target(self.rest)
+        return posture
+
+    @cached_property
+    def tasks(self) -> list[mink.Task]:
+        return [self.task] if self.posture is None else [self.task, self.posture]
+
+    @cached_property
+    def constraints(self) -> list[mink.DofFreezingTask]:
+        import mink
+
         hand = [int(d) for d in self.index.hand_dof]
-        self.constraints = [mink.DofFreezingTask(self.model, dof_indices=hand)]
-        self.seeds = tuple(np.array(s, dtype=np.float64) for s in settings.seeds)
+        return [mink.DofFreezingTask(self.model, dof_indices=hand)]
 
     def fk(self, arm_q: FloatArray) -> tuple[FloatArray, FloatArray]:
-        """Tool position (3,) and rotation (3, 3) at ``arm_q``."""
-        self._set(arm_q)
+        """Tool position (3,) and rotation (3, 3) at ``arm_q`` (the hand at rest, as in
+        mink's configuration, whose hand joints no solve moves)."""
+        d = self._kinematics
+        d.qpos[self.index.arm_qpos] = arm_q
+        mujoco.mj_kinematics(self.model, d)
         site = self.index.tool_site
-        d = self.config.data
         return d.site_xpos[site].copy(), d.site_xmat[site].reshape(3, 3).copy()
 
     def _set(self, arm_q: FloatArray) -> None:
@@ -109,6 +166,8 @@ class ArmIK(_Base):
     def _iterate(
         self, pos: FloatArray, rot: FloatArray, iterations: int, posture: bool = False
     ) -> tuple[float, float]:
+        import mink
+
         target = mink.SE3.from_rotation_and_translation(mink.SO3.from_matrix(rot), pos)
         self.task.set_target(target)
         perr = rerr = np.inf
@@ -146,10 +205,11 @@ class ArmIK(_Base):
         and aims there, not at the posture): a line's joint interpolation from its start to
         its goal, so that the spare freedom moves evenly along the line rather than at its
         end. An arm without a posture task ignores it."""
-        if self.posture is None:
+        if not self.redundant:
             guide = None
-        key = memo_key(f"{self.MEMO}-track", pos, rot, arm_q, iterations, guide)
-        known = SOLUTIONS.get(key)
+        guided = () if guide is None else (guide,)  # a key's parts are what its file keeps
+        key = memo_key(f"{self.MEMO}-track", pos, rot, arm_q, iterations, *guided)
+        known = self.memo.get(key)
         if isinstance(known, np.ndarray):
             return known.copy()
         self._set(arm_q)
@@ -163,7 +223,7 @@ class ArmIK(_Base):
             self.posture.set_target(self.rest)
             self._iterate(pos, rot, iterations)  # then back onto the line, the frame task alone
         q: FloatArray = self.config.q[self.index.arm_qpos].copy()
-        SOLUTIONS.put(key, q.copy())
+        self.memo.put(key, q.copy())
         return q
 
     def solve(self, pos: FloatArray, rot: FloatArray, arm_q: FloatArray, what: str) -> FloatArray:
@@ -176,7 +236,7 @@ class ArmIK(_Base):
         """
         start = np.asarray(arm_q, dtype=np.float64)
         key = memo_key(f"{self.MEMO}-solve", pos, rot, start)
-        known = SOLUTIONS.get(key)
+        known = self.memo.get(key)
         closest = known if isinstance(known, tuple) else (np.inf, np.inf)
         if isinstance(known, np.ndarray):
             return known.copy()
@@ -185,10 +245,10 @@ class ArmIK(_Base):
             perr, rerr = self._iterate(pos, rot, SOLVE_ITERATIONS)
             if perr <= 2e-3 and rerr <= 1e-2:
                 q: FloatArray = self.config.q[self.index.arm_qpos].copy()
-                SOLUTIONS.put(key, q.copy())
+                self.memo.put(key, q.copy())
                 return q
             closest = min(closest, (perr, rerr))
-        SOLUTIONS.put(key, closest)
+        self.memo.put(key, closest)
         raise IKError(
             f"{what} is out of the arm's reach: the tool stays {closest[0] * 1000:.1f} mm "
             f"and {np.degrees(closest[1]):.1f} deg away"
@@ -198,25 +258,34 @@ class ArmIK(_Base):
 class FingerIK(_Base):
     """Fingertip-position IK over one finger's joints, the rest of the robot frozen."""
 
-    def __init__(
-        self, model: mujoco.MjModel | None = None, profile: RobotProfile | None = None
-    ) -> None:
-        super().__init__(model, profile)
-        ix = self.index
-        self.tasks = [
+    @cached_property
+    def tasks(self) -> list[mink.FrameTask]:
+        import mink
+
+        return [
             mink.FrameTask(f.tip_site, "site", position_cost=1.0, orientation_cost=0.0)
-            for f in ix.profile.fingers
+            for f in self.index.profile.fingers
         ]
-        self.constraints = []
+
+    @cached_property
+    def constraints(self) -> list[mink.DofFreezingTask]:
+        import mink
+
+        ix = self.index
         bits = ix.hand_bits.tolist()
+        constraints = []
         for f in range(len(ix.profile.fingers)):
             free = {int(ix.hand_dof[i]) for i, b in enumerate(bits) if b // 4 == f}
             frozen = [d for d in range(self.model.nv) if d not in free]
-            self.constraints.append(mink.DofFreezingTask(self.model, dof_indices=frozen))
+            constraints.append(mink.DofFreezingTask(self.model, dof_indices=frozen))
+        return constraints
 
     def tip(self, arm_q: FloatArray, hand_q: FloatArray, finger: int) -> FloatArray:
-        self._set(arm_q, hand_q)
-        tip: FloatArray = self.config.data.site_xpos[self.index.fingertip_sites[finger]].copy()
+        d = self._kinematics
+        d.qpos[self.index.arm_qpos] = arm_q
+        d.qpos[self.index.hand_qpos] = np.asarray(hand_q)[self.index.hand_bits]
+        mujoco.mj_kinematics(self.model, d)
+        tip: FloatArray = d.site_xpos[self.index.fingertip_sites[finger]].copy()
         return tip
 
     def _set(self, arm_q: FloatArray, hand_q: FloatArray) -> None:
@@ -234,10 +303,12 @@ class FingerIK(_Base):
         iterations: int = 2,
     ) -> FloatArray:
         """Steps from ``hand_q`` moving the fingertip toward ``tip`` (world, m); returns (16,)."""
-        key = memo_key(f"finger-track-{self.memo}", finger, tip, arm_q, hand_q, iterations)
-        known = SOLUTIONS.get(key)
+        key = memo_key(f"finger-track-{self.robot}", int(finger), tip, arm_q, hand_q, iterations)
+        known = self.memo.get(key)
         if isinstance(known, np.ndarray):
             return known.copy()
+        import mink
+
         self._set(arm_q, hand_q)
         task = self.tasks[finger]
         # Position only: keep the tip's own orientation in the target, since mink's frame error
@@ -262,5 +333,5 @@ class FingerIK(_Base):
             self.config.integrate_inplace(vel, DT)
         q: FloatArray = np.asarray(hand_q, dtype=np.float64).copy()
         q[self.index.hand_bits] = self.config.q[self.index.hand_qpos]
-        SOLUTIONS.put(key, q.copy())
+        self.memo.put(key, q.copy())
         return q

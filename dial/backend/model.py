@@ -70,8 +70,9 @@ def _robot_files(folder: Path) -> dict[str, bytes]:
     return {path.name: path.read_bytes() for path in folder.glob("*.xml")}
 
 
-# Compiled models by (path, mtime) once keep_compiled() is called; None: compile every time.
-_compiled: dict[tuple[str, int], mujoco.MjModel] | None = None
+# Compiled models by (path, mtime, textures) once keep_compiled() is called; None: compile
+# every time.
+_compiled: dict[tuple[str, int, bool], mujoco.MjModel] | None = None
 
 
 def keep_compiled() -> None:
@@ -93,18 +94,23 @@ def compiled_count() -> int:
 
 
 def load_model(
-    path: str | Path | None = None, profile: RobotProfile | None = None
+    path: str | Path | None = None,
+    profile: RobotProfile | None = None,
+    *,
+    textures: bool = True,
 ) -> mujoco.MjModel:
     """Compile a robot (the default robot when ``profile`` is None), or a scene XML file that
-    includes its files; the profile's servo gains are written into the model's actuators."""
+    includes its files; the profile's servo gains are written into the model's actuators.
+    ``textures=False``: without its textures (:func:`load_untextured`)."""
     profile = default_profile() if profile is None else profile
     path = profile.model if path is None else path
+    compile_model = _compile if textures else load_untextured
     if _compiled is None:
-        return _compile(path, profile)
-    key = (f"{path}|{profile.path}", os.stat(path).st_mtime_ns)
+        return compile_model(path, profile)
+    key = (f"{path}|{profile.path}", os.stat(path).st_mtime_ns, textures)
     model = _compiled.get(key)
     if model is None:
-        model = _compiled[key] = _compile(path, profile)
+        model = _compiled[key] = compile_model(path, profile)
     return copy.copy(model)
 
 
@@ -118,10 +124,12 @@ def _compile(path: str | Path, profile: RobotProfile) -> mujoco.MjModel:
 
 
 def load_untextured(path: str | Path, profile: RobotProfile | None = None) -> mujoco.MjModel:
-    """Compile a scene without its textures, for what never draws it (``dial preview``).
+    """Compile a scene without its textures, for what never draws it (``dial preview``, and
+    ``dial run`` with no observer).
 
     A scene's skybox and floor textures take most of its compile time; without them only the
-    textures' fields, the materials' references to them and the name addresses differ.
+    textures' fields, the materials' references to them and the name addresses differ: no
+    physics reads them (tests/engine/test_textures.py runs a scene both ways, to the bit).
     """
     profile = default_profile() if profile is None else profile
     try:

@@ -3,24 +3,38 @@
 from __future__ import annotations
 
 import argparse
+import gc
 import os
 import signal
 import sys
 from collections.abc import Iterator
 from contextlib import contextmanager
 from types import FrameType
+from typing import TYPE_CHECKING
 
-from dial.api import load
 from dial.errors import OptionError
-from dial.parser.script import Script
+
+if TYPE_CHECKING:
+    from dial.parser.script import Script
 
 UsageError = OptionError  # a usage problem: exit status 2
 # Set by a command whose process must end at once after its last word (dial run --remote).
 EXIT_AT_ONCE = False
 
 
+def collect_from_here() -> None:
+    """Let the garbage collector run again, if the ``dial`` program stopped it for its
+    start-up (:func:`dial.cli.main`); what exists now is frozen: it lives to the exit, and
+    the collector need not look at it again."""
+    if not gc.isenabled():
+        gc.freeze()
+        gc.enable()
+
+
 def load_script(arg: str, scene: str | None) -> Script:
     """A script argument (a path, else a bundled name), checked against ``--scene``."""
+    from dial.api import load  # the parser: not for --help
+
     return load(arg, scene=scene)
 
 

@@ -111,10 +111,18 @@ def add_run_options(p: argparse.ArgumentParser) -> None:
     g = p.add_argument_group(
         "remote robot (docs/remote.md)",
         "Run at a robot served by 'dial serve': the summary and criteria are the robot's, "
-        "the log adds link records (sent, acknowledged, reported, late, lost, diverged).",
+        "the log adds link records (sent, acknowledged, reported, late, lost, diverged). "
+        "The robot's world (--perturb, --seed, --disturb) is set at 'dial serve'; with "
+        "--remote those, the debugging options, --realtime, --video, --viewer, "
+        "--log-states, --dataset and --save-world are usage errors.",
     )
     g.add_argument("--remote", metavar="URL", help="the robot's server, ws://HOST:PORT")
-    g.add_argument("--token-file", metavar="F", help="the robot's token file")
+    g.add_argument(
+        "--token-file",
+        metavar="F",
+        help="the robot's token file, as 'dial serve' wrote it (default: "
+        "$XDG_STATE_HOME/dial/token, that is ~/.local/state/dial/token)",
+    )
     g.add_argument(
         "--split",
         choices=("script", "block"),
@@ -123,14 +131,19 @@ def add_run_options(p: argparse.ArgumentParser) -> None:
         "here and send each block tagged with its start tick",
     )
     g.add_argument(
-        "--link", metavar="SPEC", help="emulate a link: 'delay=1s jitter=100ms bandwidth=...'"
+        "--link",
+        metavar="SPEC",
+        help="emulate a link on the way: 'delay=2s jitter=300ms bandwidth=2400bps cut=T:D "
+        "blackhole=T seed=N' (any of them; as 'dial link')",
     )
     g.add_argument(
         "--lead",
         type=float,
         metavar="S",
         help="--split block: tag a block that waited for a report S s of robot time ahead "
-        "(default: 1.5 round trips measured at connect, and 0.2 s)",
+        "(default: 1.5 round trips and 0.2 s; the round trip is --link's worst, else the one "
+        "measured at connect, and then the lead is rounded up to 0.5, 1, 2, 4... s; the "
+        "operator says which)",
     )
     g.add_argument(
         "--diverge",
@@ -141,7 +154,10 @@ def add_run_options(p: argparse.ArgumentParser) -> None:
         "prediction (default 10)",
     )
     g.add_argument(
-        "--no-predict", action="store_true", help="do not run the prediction on this side"
+        "--no-predict",
+        action="store_true",
+        help="do not predict the robot on this side (no 'diverged' records; --record and "
+        "--rerun draw the prediction, so they need it)",
     )
 
 
@@ -184,6 +200,28 @@ def cmd_link(args: argparse.Namespace) -> int:
     return run_link(host, port, args.to, parse_link(args.spec))
 
 
+# ``dial run`` options a remote run does not take: (dest, flag, why).
+WORLD = "the robot's world is perturbed and disturbed at 'dial serve'"
+PACED = "a remote run is paced by the robot: it does not pause, save or resume"
+SEEN = "the operator sees the robot in decimated telemetry: frames are a local run's"
+MODEL = "the world model that touch updates is the robot's"
+LOCAL_ONLY = (
+    ("perturb", "--perturb", WORLD),
+    ("seed", "--seed", WORLD),
+    ("disturb", "--disturb", WORLD),
+    ("breaks", "--break", PACED),
+    ("step", "--step", PACED),
+    ("save_at", "--save-at", PACED),
+    ("resume", "--resume", PACED),
+    ("realtime", "--realtime", PACED),
+    ("video", "--video", SEEN),
+    ("viewer", "--viewer", SEEN),
+    ("log_states", "--log-states", SEEN),
+    ("dataset", "--dataset", SEEN),
+    ("save_world", "--save-world", MODEL),
+)
+
+
 def check_remote(args: argparse.Namespace) -> None:
     """Usage errors of ``dial run --remote`` (what only the robot, or only a local run, has)."""
     if args.remote is None:
@@ -195,34 +233,24 @@ def check_remote(args: argparse.Namespace) -> None:
         return
     if not args.remote.startswith(("ws://", "wss://")):
         raise UsageError(f"--remote: expected ws://HOST:PORT, got '{args.remote}'")
-    local = {
-        "--perturb": args.perturb,
-        "--seed": args.seed,
-        "--disturb": args.disturb,
-        "--video": args.video,
-        "--viewer": args.viewer,
-        "--log-states": args.log_states,
-        "--break": args.breaks,
-        "--step": args.step,
-        "--save-at": args.save_at,
-        "--resume": args.resume,
-        "--realtime": args.realtime,
-        "--record": args.record,  # not yet: the predicted and the reported robot together
-        "--rerun": args.rerun,
-        "--dataset": args.dataset,  # a local run's episode; the robot's telemetry is decimated
-        "--save-world": args.save_world,  # the world model is the robot's
-    }
-    given = [flag for flag, value in local.items() if value]
+    given = [flag for dest, flag, _ in LOCAL_ONLY if getattr(args, dest)]
     if given:
+        why = dict.fromkeys(why for dest, _, why in LOCAL_ONLY if getattr(args, dest))
+        raise UsageError(f"{', '.join(given)}: not with --remote ({'; '.join(why)})")
+    if (args.record or args.rerun) and args.no_predict:
         raise UsageError(
-            f"{', '.join(given)}: not with --remote (the robot's world is perturbed and "
-            "disturbed at 'dial serve'; a remote run is paced by the robot; a recording of "
-            "the predicted and the reported robot together is not done yet)"
+            "--record and --rerun draw the prediction beside the robot: not with --no-predict"
         )
+    if args.record or args.rerun:
+        from dial.api import check_watching
+
+        check_watching(args.record, None, args.rerun, False)
     if args.link is not None:
         from dial.remote.link import parse_link  # a usage error before anything connects
 
         parse_link(args.link)
+    if args.lead is not None and args.split != "block":
+        raise UsageError("--lead: only with --split block (how far ahead a block is tagged)")
     if args.lead is not None and not (math.isfinite(args.lead) and args.lead > 0):
         raise UsageError(f"--lead must be above 0 s, got {args.lead:g}")
     if not (math.isfinite(args.diverge) and args.diverge > 0):

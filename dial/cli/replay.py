@@ -6,7 +6,6 @@ import argparse
 import sys
 from pathlib import Path
 
-from dial.api import writable
 from dial.cli.common import UsageError
 
 
@@ -31,6 +30,7 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
 
 
 def cmd_replay(args: argparse.Namespace) -> int:
+    from dial.api import writable
     from dial.recording.timeline import read_log, timeline
 
     path = Path(args.log)

@@ -10,19 +10,18 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from dial import api
 from dial.cli.common import (
     UsageError,
+    collect_from_here,
     dataset_arguments,
     dataset_request,
     load_script,
     scene_argument,
 )
 from dial.cli.remote import add_run_options, check_remote
-from dial.recording.timeline import qualified_event
 from dial.scheduler.signals import EXIT_STATUS, StopRequest, catch_stop_signals
 
-if TYPE_CHECKING:
+if TYPE_CHECKING:  # what a run needs loads when it runs: `dial --help` stays quick
     from dial.dataset.writer import DatasetWriter
     from dial.engine import RunResult
 
@@ -87,7 +86,8 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         "--record",
         metavar="FILE.rrd",
         help="write a rerun recording: geometry, body poses, joints, tendons, tactile "
-        "images, event lanes (open with 'rerun FILE.rrd'; see docs/recording.md)",
+        "images, event lanes (open with 'rerun FILE.rrd'; see docs/recording.md); with "
+        "--remote, the predicted robot and the reported one together",
     )
     p.add_argument(
         "--video",
@@ -139,11 +139,14 @@ def cmd_run(args: argparse.Namespace) -> int:
     check_remote(args)
     with catch_stop_signals() as stop:
         if args.remote is not None:
+            collect_from_here()
             return _remote(args, stop)
         return _run(args)
 
 
 def _run(args: argparse.Namespace) -> int:
+    from dial import api  # the parser and the engine: not for --help
+
     if args.log_states and not args.log:
         raise UsageError("--log-states writes into the log: give --log FILE.jsonl too")
     save_at = _save_at(args.save_at)
@@ -164,6 +167,10 @@ def _run_api(
     writer: DatasetWriter | None,
     cameras: list[str],
 ) -> RunResult:
+    # The parser and the engine (not for --help), all loaded before the collector runs again.
+    from dial import api, engine  # noqa: F401
+
+    collect_from_here()
     return api.run(
         args.script,
         scene=args.scene,
@@ -246,6 +253,7 @@ def _report(args: argparse.Namespace, result: RunResult, save_at: tuple[int, str
 
 def _remote(args: argparse.Namespace, stop: StopRequest) -> int:
     """``dial run --remote``: the options and the script checked here, then the robot's run."""
+    from dial import api
     from dial.cli.run_remote import run_remote
 
     api.check_options(args.tick, args.speed, args.seed, args.perturb)
@@ -282,6 +290,8 @@ def _progress(quiet: bool) -> Callable[[int, float, list[str]], None] | None:
 
 def summary_text(result: RunResult) -> str:
     """The table ``dial run`` prints: each run's end, the times, the criteria (pure)."""
+    from dial.recording.timeline import qualified_event
+
     s = result.summary
     lines = [f"scene {result.world.name}: {s.ticks} ticks of {s.tick_length:g} s"]
     ends = result.log.of("end")

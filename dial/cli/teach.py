@@ -7,12 +7,26 @@ import sys
 from pathlib import Path
 
 from dial.cli.common import UsageError, plot_usage
-from dial.instructions.scene_names import SceneNotFoundError
+
+_TABLE = "(the command table)"  # dial teach --help's epilog, written when it is printed
+
+
+class _TeachHelp(argparse.RawDescriptionHelpFormatter):
+    """``dial teach --help``: the command table is read from :mod:`dial.teach.commands` only
+    when the help is printed, so that building the parser (every command) stays quick."""
+
+    def add_text(self, text: str | None) -> None:
+        if text == _TABLE:
+            from dial.teach.commands import help_text
+
+            text = (
+                help_text() + "\n\nlengths are mm and angles degrees unless a unit is written "
+                "(1cm, 0.1rad); 'appro' and 'depart' take metres, as in world-file programs."
+            )
+        super().add_text(text)
 
 
 def add_parsers(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
-    from dial.teach.commands import help_text  # the table only: no MuJoCo at parser time
-
     p = sub.add_parser(
         "teach",
         help="jog the arm, move and limp the fingers, and save poses and locations",
@@ -22,9 +36,8 @@ def add_parsers(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> Non
         "kept, a .bak backup). At a terminal, commands have line editing and tab "
         "completion; when stdin is not a terminal they are read line by line and echoed, "
         "and the first command that fails ends the session (exit 1). See docs/teaching.md.",
-        epilog=help_text() + "\n\nlengths are mm and angles degrees unless a unit is "
-        "written (1cm, 0.1rad); 'appro' and 'depart' take metres, as in world-file programs.",
-        formatter_class=argparse.RawDescriptionHelpFormatter,
+        epilog=_TABLE,
+        formatter_class=_TeachHelp,
     )
     p.add_argument(
         "--scene", required=True, metavar="NAME_OR_PATH", help="a bundled scene or world file"
@@ -64,6 +77,7 @@ def add_parsers(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> Non
 
 
 def _scene(arg: str, option: str = "--scene") -> str:
+    from dial.instructions.scene_names import SceneNotFoundError
     from dial.scene.resolve import scene_option
 
     try:

@@ -12,9 +12,6 @@ from pathlib import Path
 
 from dial.cli.common import load_script, scene_argument
 from dial.errors import DialError, ScriptError
-from dial.parser.fmt import format_text
-from dial.parser.show import render
-from dial.parser.timeline import length
 
 
 def add_parsers(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
@@ -56,6 +53,8 @@ def add_parsers(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> Non
 
 
 def cmd_check(args: argparse.Namespace) -> int:
+    from dial.parser.timeline import length
+
     status = 0
     for arg in args.scripts:
         try:
@@ -63,7 +62,8 @@ def cmd_check(args: argparse.Namespace) -> int:
         except ScriptError as e:
             print(e.render())
             n = len(e.diagnostics)
-            print(f"{arg}: {n} error{'s' if n != 1 else ''}")
+            more = ", and lines not checked" if e.cutoffs else ""
+            print(f"{arg}: {n} error{'s' if n != 1 else ''}{more}")
             status = 1
             continue
         ticks = length(script)  # by arithmetic: a check never unrolls repeats
@@ -72,12 +72,16 @@ def cmd_check(args: argparse.Namespace) -> int:
 
 
 def cmd_show(args: argparse.Namespace) -> int:
+    from dial.parser.show import render
+
     script = load_script(args.script, args.scene)
     sys.stdout.write(render(script))
     return 0
 
 
 def cmd_fmt(args: argparse.Namespace) -> int:
+    from dial.parser.fmt import format_text
+
     status = 0
     for arg in args.scripts:
         path = Path(arg)

@@ -6,7 +6,6 @@ import argparse
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from dial import api
 from dial.cli.common import (
     UsageError,
     at_least,
@@ -16,8 +15,6 @@ from dial.cli.common import (
     scene_argument,
     sigterm_as_interrupt,
 )
-from dial.disturb import parse_disturbance
-from dial.instructions.scene_names import SceneNotFoundError
 
 if TYPE_CHECKING:
     from dial.dataset.plan import Request
@@ -86,12 +83,15 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
 
 def _own_tick(script: str, scene: str | None) -> tuple[float]:
     """Without ``--ticks``, the script's own tick (checked here, as the sweep would)."""
-    from dial.engine.run import DEFAULT_TICK
+    from dial.scheduler.types import DEFAULT_TICK
 
     return (load_script(script, scene).tick or DEFAULT_TICK,)
 
 
 def cmd_tune(args: argparse.Namespace) -> int:
+    from dial import api
+    from dial.disturb import parse_disturbance
+    from dial.instructions.scene_names import SceneNotFoundError
     from dial.scene.resolve import scene_option
     from dial.tune import ProcessExecutor, TuneOptions, models, parse_ticks, tune
 

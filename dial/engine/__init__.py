@@ -2,7 +2,8 @@
 
 from dial.engine.observe import Observer, StateLog, Watched
 from dial.engine.result import Criteria, RunResult
-from dial.engine.run import DEFAULT_TICK, RunOptions, run, tick_length
+from dial.engine.run import RunOptions, run, tick_length
+from dial.scheduler.types import DEFAULT_TICK
 
 __all__ = [
     "DEFAULT_TICK",

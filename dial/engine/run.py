@@ -12,15 +12,13 @@ import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TextIO
+from typing import TYPE_CHECKING, TextIO
 
 import trio
 
 from dial.backend.driver import MujocoRobot
-from dial.debug import Break, Console, Session
 from dial.disturb import Disturbance
 from dial.engine.beliefs import believed_world, journal
-from dial.engine.debugging import session
 from dial.engine.observe import Observer, StateLog, Watched, describe, fan_out, first_line
 from dial.engine.result import RunResult, measure_criteria
 from dial.engine.setup import Factory, prepare
@@ -35,8 +33,11 @@ from dial.scheduler.position import Resume
 from dial.scheduler.runner import Runner, Tally
 from dial.scheduler.signals import StopRequest, catch_stop_signals
 from dial.scheduler.ticks import Progress, TickLoop
+from dial.scheduler.types import DEFAULT_TICK
 
-DEFAULT_TICK = 0.25  # s, when neither the script (@tick) nor the command line sets one
+if TYPE_CHECKING:  # a run that pauses or saves brings the debugger: others do without it
+    from dial.debug import Break, Console, Session
+
 MAX_TICK = 60.0  # s, as @tick's range
 
 
@@ -90,8 +91,15 @@ def run(script: Script, options: RunOptions) -> RunResult:
         stop = options.stop if options.stop is not None else signals
         log = EventLog(options.log)
         settings = _settings(script, options)
+        drawn = bool(options.observers)  # an observer may draw: it gets the scene's textures
         robot, ctx = prepare(
-            script, log, settings.perturb_mm, settings.seed, settings.disturb, options.follow_grasps
+            script,
+            log,
+            settings.perturb_mm,
+            settings.seed,
+            settings.disturb,
+            textures=drawn,
+            follow=options.follow_grasps,
         )
         resume = _resume(script, options.resume, robot, ctx, log)
         states = [StateLog(lanes=LanePlan.from_script(script))] if options.log_states else []
@@ -199,6 +207,8 @@ def _debugging(
     """The session's hooks, if the run pauses or saves; None keeps the runner's hot path lean."""
     if not (options.breaks or options.step or options.save_at):
         return None
+    from dial.engine.debugging import session
+
     return session(
         script,
         loop_of,

@@ -70,13 +70,17 @@ def prepare(
     perturb_mm: float = 0.0,
     seed: int = 0,
     disturbances: Sequence[Disturbance] = (),
+    textures: bool = True,
     follow: bool = True,
 ) -> tuple[MujocoRobot, Context]:
     """Load the scene, place the robot at home, perturb, settle; log the ``scene`` record.
+
+    ``textures=False``: compile the scene without its textures (a run that nothing draws;
+    the physics is the same to the bit, and the compile is a fifth of the time).
     ``follow=False``: grasped objects do not follow the hand in the world model."""
     world = script_world(script)
     profile = profile_at(world.robot)
-    model = load_model(world.model_path, profile)
+    model = load_model(world.model_path, profile, textures=textures)
     set_turns(model, world)
     placed = Disturbances.on(model, disturbances)  # an unknown body fails before anything moves
     index = RobotIndex.from_model(model, profile)
@@ -108,7 +112,7 @@ def prepare(
     log.write("scene", scene=world.name, world=where, perturb=shift, seed=seed)
     robot = MujocoRobot(model, data, disturbances=placed, profile=profile)
     beliefs = Beliefs(world, believed, sizes, follow=follow, feeling=feeling(robot))
-    fik = FingerIK(profile=profile)
+    fik = FingerIK(ik.model, profile)
     return robot, Context(robot, robot.view, world, believed, ik, fik, beliefs=beliefs)
 
 

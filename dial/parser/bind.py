@@ -27,14 +27,17 @@ def _parse(spec: ParamSpec[object], word: Word, errors: list[tuple[Span, str]]) 
         return None
 
 
-def bind(instr: Instruction, defn: Definition) -> tuple[Bound, list[tuple[Span, str]]]:
-    """Bind ``defn``'s parameters; return the arguments and any problems."""
+def bind(
+    instr: Instruction, defn: Definition, limit: int | None = None
+) -> tuple[Bound, list[tuple[Span, str]]]:
+    """Bind ``defn``'s parameters; return the arguments and any problems (at most ``limit``
+    of the ``key=value`` ones: the checker stops at so many)."""
     errors: list[tuple[Span, str]] = []
     bound = Bound({}, {})
     specs = _positional(instr, defn, bound, errors)
     if specs is None:
         return bound, errors
-    _keyed(instr, defn, bound, errors)
+    _keyed(instr, defn, bound, errors, limit)
     args = bound.args
     for spec in specs if instr.verbs else instr.params:
         if spec.name in args:
@@ -84,12 +87,18 @@ def _positional(
 
 
 def _keyed(
-    instr: Instruction, defn: Definition, bound: Bound, errors: list[tuple[Span, str]]
+    instr: Instruction,
+    defn: Definition,
+    bound: Bound,
+    errors: list[tuple[Span, str]],
+    limit: int | None,
 ) -> None:
-    """Bind the ``key=value`` parameters."""
+    """Bind the ``key=value`` parameters, until ``limit`` problems are found."""
     for p in defn.params:
         if p.key is None:
             continue
+        if limit is not None and len(errors) >= limit:
+            return
         keyed = None if instr.verbs else instr.spec(p.key)
         if keyed is None:
             names = [s.name for s in instr.params if not instr.verbs]

@@ -10,12 +10,12 @@ from __future__ import annotations
 
 import gc
 from collections.abc import Iterator, Mapping
-from contextlib import contextmanager
+from contextlib import contextmanager, suppress
 from dataclasses import dataclass, field, replace
 from difflib import get_close_matches
 from pathlib import Path
 
-from dial.errors import Diagnostic, ScriptError, Span
+from dial.errors import MAX_PROBLEMS, Diagnostic, ScriptError, Span, TooManyProblems, tally
 from dial.instructions.base import Instruction, Values
 from dial.instructions.catalogue import INSTRUCTIONS, WATCHABLE
 from dial.instructions.robot_checks import robot_errors
@@ -69,7 +69,7 @@ class _Context:
 
 class _Checker:
     def __init__(self, program: Program, source: str, origin: Path, ctx: _Context) -> None:
-        self.program = program
+        self.program, self.seen = program, 0  # the file's problems so far
         self.ctx = ctx
         self.origin = origin  # the real file, for resolving @call and @scene paths
         self.source = source
@@ -85,8 +85,10 @@ class _Checker:
             self.lines = self.source.split("\n")
         text = self.lines[span.line - 1] if 0 < span.line <= len(self.lines) else ""
         self.ctx.diags.append(Diagnostic(self.program.path, span, message, text))
+        self.seen = tally(self.seen + 1, self.ctx.diags, self.program.path, span.line, self.source)
 
-    def run(self) -> Script:
+    def run(self, seen: int = 0) -> Script:
+        self.seen = tally(seen, self.ctx.diags, self.program.path, 0, self.source)
         self.load_scene()
         for d in self.program.definitions:
             self.define(d)
@@ -138,14 +140,11 @@ class _Checker:
         instr = INSTRUCTIONS.get(d.instruction)
         if instr is None:
             valid = list(INSTRUCTIONS)
-            self.error(
-                d.instruction_span,
-                f"unknown instruction '{d.instruction}'"
-                + (_hint(d.instruction, valid) or _choices(valid)),
-            )
+            hint = _hint(d.instruction, valid) or _choices(valid)
+            self.error(d.instruction_span, f"unknown instruction '{d.instruction}'{hint}")
             self.broken.add(d.event)
             return
-        bound, errors = bind(instr, d)
+        bound, errors = bind(instr, d, limit=MAX_PROBLEMS - self.seen)
         errors = errors or robot_errors(d, bound, self.scene.robot if self.scene else None)
         for span, message in errors:
             self.error(span, f"event '{d.event}': {message}")
@@ -321,7 +320,10 @@ def _check(text: str, path: str, origin: Path, ctx: _Context) -> Script:
     """
     program, syntax = parse_partial(text, path, depth=ctx.depth)
     ctx.diags.extend(syntax)
-    return _Checker(program, text, origin, ctx.entering(origin)).run()
+    checker = _Checker(program, text, origin, ctx.entering(origin))
+    with suppress(TooManyProblems):  # at the file's MAX_PROBLEMS-th problem, as compilers do
+        return checker.run(len(syntax))  # (a parser that stopped there left its Cutoff too)
+    return Script(program.path, program, {}, frozenset(), (), None, ctx.scene_override)
 
 
 def _check_file(path: Path, display: str, ctx: _Context) -> Script:
@@ -346,15 +348,15 @@ def _no_gc() -> Iterator[None]:
 
     Afterwards, freezing and at once unfreezing moves what the check made into the oldest
     generation without a pass over it (a young-generation pass over a large script's tree
-    costs a fifth of its check); it stays collectable there, as any long-lived data.
-    """
+    costs a fifth of its check); it stays collectable there, as any long-lived data."""
     enabled = gc.isenabled()
     gc.disable()
     try:
         yield
     finally:
-        gc.freeze()
-        gc.unfreeze()
+        if gc.get_freeze_count() == 0:  # else unfreezing frees what was frozen (dial's start)
+            gc.freeze()
+            gc.unfreeze()
         if enabled:
             gc.enable()
 

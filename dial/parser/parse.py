@@ -10,7 +10,7 @@ from difflib import get_close_matches
 from functools import lru_cache
 from typing import NamedTuple
 
-from dial.errors import Diagnostic, ScriptError, Span, shorten
+from dial.errors import Diagnostic, ScriptError, Span, TooManyProblems, shorten, tally
 from dial.parser import directives as args
 from dial.parser.ast import (
     Block,
@@ -95,11 +95,10 @@ _read_short = lru_cache(maxsize=4096)(_read_line)
 
 class _Parser:
     def __init__(self, text: str, path: str, depth: int = 0) -> None:
-        self.path = path
-        self.lines, problems = scan(text)
+        self.path, self.text = path, text
+        self.lines, self.lexical = scan(text)
         self.diags: list[Diagnostic] = []
-        for span, message in problems:
-            self.error(span, message)
+        self.at = 0  # the line being read (after the last: the end of the file)
         self.structure = Structure(self.error, depth)
         self.block: list[_PendingLine] = []
         self.block_ok = True
@@ -111,11 +110,15 @@ class _Parser:
     def error(self, span: Span, message: str) -> None:
         ln = self.lines[span.line - 1] if 0 < span.line <= len(self.lines) else None  # numbered 1..
         self.diags.append(Diagnostic(self.path, span, message, ln.text if ln else ""))
+        tally(len(self.diags), self.diags, self.path, max(span.line, self.at), self.text)
 
     # -- driver ---------------------------------------------------------------------------
     def run(self) -> Program:
+        for span, message in self.lexical:
+            self.error(span, message)
         execution, comment = Kind.EXECUTION, Kind.COMMENT
         for ln in self.lines:
+            self.at = ln.number
             kind = ln.kind
             if kind is execution:
                 self.execution(ln)
@@ -130,6 +133,7 @@ class _Parser:
                 self.directive(ln)
             elif kind is Kind.OTHER:
                 self.other(ln)
+        self.at = len(self.lines)
         self.flush()
         body = self.structure.finish()
         # The structure reports through this parser: drop it, so that no reference cycle
@@ -365,7 +369,10 @@ def parse_partial(
     towards :data:`~dial.parser.structure.MAX_NESTING`.
     """
     parser = _Parser(text, path, depth)
-    program = parser.run()
+    try:
+        program = parser.run()
+    except TooManyProblems:  # what was read so far, nothing after it (its Cutoff is last)
+        program = Program(path, None, None, None, tuple(parser.definitions.values()), ())
     return program, parser.diags
 
 

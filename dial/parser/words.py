@@ -8,6 +8,7 @@ words count one by one, as in the paper's ``"0x0666_0x0222 400"``), or
 from __future__ import annotations
 
 import re
+from dataclasses import fields
 
 from dial.errors import Span
 from dial.parser.ast import Param, Word
@@ -52,6 +53,13 @@ def tokenize(line: int, code: str, start: int) -> list[Param]:
     bare = bare_words(line, code, start)
     if bare is not None:
         return [Param(None, (w,), False, w.span) for w in bare]
+    if code.find('"', start) < 0:
+        return _unquoted(line, code, start)
+    return _general(line, code, start)
+
+
+def _general(line: int, code: str, start: int) -> list[Param]:
+    """:func:`tokenize` of any parameters, quoted groups included."""
     params: list[Param] = []
     n = len(code)
     i = _SPACE.match(code, start).end()  # type: ignore[union-attr]  # matches empty too
@@ -94,3 +102,59 @@ def tokenize(line: int, code: str, start: int) -> list[Param]:
             params.append(Param(key, (word,), False, Span(line, begin + 1, end + 1)))
         i = _SPACE.match(code, end).end()  # type: ignore[union-attr]
     return params
+
+
+def _unquoted(line: int, code: str, start: int) -> list[Param]:
+    """:func:`tokenize` of parameters without quotes: each word is a bare word or
+    ``key=value`` (the value up to the next space, ``=`` included). Lean, as a 300 KB line
+    of parameters is 75,000 of them (issue 26): spans are made as plain tuples are, and
+    words and parameters by setting their slots (``tests/test_properties.py`` holds this
+    path to :func:`_general`'s results)."""
+    params: list[Param] = []
+    append, span = params.append, tuple.__new__
+    for m in _WORD.finditer(code, start):
+        text = m.group()
+        begin, end = m.span()
+        eq = text.find("=")
+        if eq < 0:
+            at = span(Span, (line, begin + 1, end + 1))
+            append(_param(None, _word(text, at), at))
+            continue
+        key = text[:eq]
+        if not _KEY.match(key):
+            raise WordError(
+                Span(line, begin + 1, begin + eq + 2),
+                f"expected key=value with a name before '=', got '{text[: eq + 1]}'",
+            )
+        if eq == len(text) - 1:
+            raise WordError(Span(line, begin + 1, end + 1), f"missing value after '{key}='")
+        word = _word(text[eq + 1 :], span(Span, (line, begin + eq + 2, end + 1)))
+        append(_param(key, word, span(Span, (line, begin + 1, end + 1))))
+    return params
+
+
+# A Word and an unquoted Param without their dataclass __init__ (a Python frame and a
+# generic setattr per field): their slots are set through the slots' own descriptors.
+assert [f.name for f in fields(Word)] == ["text", "span"]
+assert [f.name for f in fields(Param)] == ["key", "words", "quoted", "span"]
+_NEW = object.__new__
+_TEXT, _SPAN = (Word.__dict__[name].__set__ for name in ("text", "span"))
+_KEY_OF, _WORDS, _QUOTED, _PARAM_SPAN = (
+    Param.__dict__[name].__set__ for name in ("key", "words", "quoted", "span")
+)
+
+
+def _word(text: str, at: Span) -> Word:
+    word: Word = _NEW(Word)
+    _TEXT(word, text)
+    _SPAN(word, at)
+    return word
+
+
+def _param(key: str | None, word: Word, at: Span) -> Param:
+    param: Param = _NEW(Param)
+    _KEY_OF(param, key)
+    _WORDS(param, (word,))
+    _QUOTED(param, False)
+    _PARAM_SPAN(param, at)
+    return param

@@ -10,13 +10,12 @@ from __future__ import annotations
 from pathlib import Path
 
 from dial.backend.driver import CONTROL_PERIOD
-from dial.engine.run import DEFAULT_TICK
 from dial.parser.script import Script
 from dial.preview.report import Counts, PreviewResult
 from dial.preview.scene import Scene
 from dial.preview.walk import Walk
 from dial.scene.of_script import script_world
-from dial.scheduler.runner import periods_per_tick
+from dial.scheduler.types import DEFAULT_TICK, periods_per_tick
 
 
 def preview(script: Script, storyboard: Path | None = None) -> PreviewResult:

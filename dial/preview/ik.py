@@ -4,19 +4,20 @@
 would, thousands for a long script; mink's QP machinery costs most of that. :class:`LeanArmIK`
 solves the same QP directly, so its answers equal the run's to rounding (docs/debugging.md
 gives the figures); :class:`FingerIKOnDemand` is the run's finger IK, set up only when a
-script needs it.
+script needs it. Like the run's, its answers are memoized (apart from the run's), in the
+user's cache folder too, and mink and SciPy load only when it meets a new problem.
 """
 
 from __future__ import annotations
 
 import copy
 import math
-from typing import Any
+from collections.abc import Callable
+from functools import cached_property
+from typing import Any, NamedTuple
 
-import mink
 import mujoco
 import numpy as np
-from scipy.linalg import lapack
 
 from dial.backend.ik import (
     DAMPING,
@@ -26,6 +27,7 @@ from dial.backend.ik import (
     ArmIK,
     FingerIK,
 )
+from dial.robot.memo import memo_key
 from dial.robot.snapshot import FloatArray
 from dial.robots.profile import RobotProfile
 
@@ -42,8 +44,8 @@ class LeanArmIK(ArmIK):
     waypoint) and a solve (a target) equal ArmIK's to rounding (1e-10 rad on the bundled
     scripts), for a fifth of the cost. A start of :meth:`ArmIK.solve` that has not
     converged after :data:`LEAN_ITERATIONS` is left to mink from its beginning, so that a
-    target out of reach fails as in the run. Memoized apart from ArmIK, so that a run never
-    reads these answers.
+    target out of reach fails as in the run. Memoized apart from ArmIK (in a file of its
+    own, as its code differs), so that a run never reads these answers.
     """
 
     MEMO = "lean-arm"
@@ -52,15 +54,25 @@ class LeanArmIK(ArmIK):
         self, model: mujoco.MjModel | None = None, profile: RobotProfile | None = None
     ) -> None:
         super().__init__(model, profile)
-        self.MEMO = f"lean-arm:{self.memo}"
-        limit, task, qpos = self.limits[0], self.task, self.index.arm_qpos
-        self._qpos, self._dof = _as_slice(qpos), _as_slice(self.index.arm_dof)
-        self._reach = (limit.gain * limit.lower[qpos], limit.gain * limit.upper[qpos], limit.gain)
-        self._weights = (task.cost * -task.gain, task.cost[:, None])
+        self.MEMO = f"lean-arm:{self.robot}"
+        self._qpos, self._dof = _as_slice(self.index.arm_qpos), _as_slice(self.index.arm_dof)
         self._velocity = np.zeros(self.model.nv)
-        self._damping = DAMPING * np.eye(len(qpos))  # mink's, as its task adds none of its own
-        assert task.lm_damping == 0.0, "the frame task's own damping is not modelled here"
         self._tools: dict[bytes, FloatArray] = {}  # fk (position, rotation) where tracks ended
+
+    @cached_property
+    def _qp(self) -> _QP:
+        """mink's weights, gain, damping and joint-limit bounds of a step, from its own frame
+        task and limit: made when the first solve needs them (mink loads then)."""
+        from scipy.linalg import lapack
+
+        limit, task, qpos = self.limits[0], self.task, self.index.arm_qpos
+        assert task.lm_damping == 0.0, "the frame task's own damping is not modelled here"
+        return _QP(
+            lapack.dgesv,
+            (task.cost * -task.gain, task.cost[:, None]),
+            DAMPING * np.eye(len(qpos)),  # mink's, as its task adds none of its own
+            (limit.gain * limit.lower[qpos], limit.gain * limit.upper[qpos], limit.gain),
+        )
 
     def fk(self, arm_q: FloatArray) -> tuple[FloatArray, FloatArray]:
         known = self._tools.get(np.asarray(arm_q, dtype=np.float64).tobytes())
@@ -76,13 +88,17 @@ class LeanArmIK(ArmIK):
         iterations: int = 2,
         guide: FloatArray | None = None,
     ) -> FloatArray:
-        """:meth:`ArmIK.track` without the memo: the planner keeps a line whole, and no
-        waypoint is asked for twice otherwise (the memo's bookkeeping was all cost)."""
-        if guide is not None and self.posture is not None:  # a redundant arm: mink's QP
+        """:meth:`ArmIK.track`, the lean way (a redundant arm's guided line: mink's QP)."""
+        if guide is not None and self.redundant:
             return super().track(pos, rot, arm_q, iterations, guide)
+        key = memo_key(f"{self.MEMO}-track", pos, rot, arm_q, iterations)
+        known = self.memo.get(key)
+        if isinstance(known, np.ndarray):
+            return known.copy()
         self._set(arm_q)
         self._iterate(pos, rot, iterations)
         q: FloatArray = self.config.data.qpos[self._qpos].copy()
+        self.memo.put(key, q.copy())
         return q
 
     def _set(self, arm_q: FloatArray) -> None:
@@ -94,8 +110,10 @@ class LeanArmIK(ArmIK):
     def _iterate(
         self, pos: FloatArray, rot: FloatArray, iterations: int, posture: bool = False
     ) -> tuple[float, float]:
-        if len(self.tasks) > 1:  # a posture task (a redundant arm): mink's QP as it is
+        if self.redundant:  # a posture task: mink's QP as it is
             return super()._iterate(pos, rot, iterations, posture)
+        import mink
+
         task, config = self.task, self.config
         target = np.empty(7)
         mujoco.mju_mat2Quat(target[:4], np.ascontiguousarray(rot, dtype=np.float64).ravel())
@@ -128,18 +146,24 @@ class LeanArmIK(ArmIK):
 
     def _step(self, err: FloatArray, jac: FloatArray) -> FloatArray:
         """The step mink's QP takes (its weights, gain, damping and joint-limit bounds)."""
-        error_weights, jac_weights = self._weights
+        dgesv, (error_weights, jac_weights), damping, (low, high, gain) = self._qp
         error, weighted = error_weights * err, jac_weights * jac
         hessian = weighted.T @ weighted
-        hessian += self._damping
+        hessian += damping
         gradient = error @ weighted
-        step: FloatArray = lapack.dgesv(hessian, gradient)[2]  # as numpy.linalg.solve
-        low, high, gain = self._reach
+        step: FloatArray = dgesv(hessian, gradient)[2]  # as numpy.linalg.solve
         moved = gain * self.config.data.qpos[self._qpos]
         low, high = low - moved, high - moved
         if np.count_nonzero(step < low) or np.count_nonzero(step > high):
             return box_qp(hessian, gradient, low, high)
         return step
+
+
+class _QP(NamedTuple):
+    dgesv: Callable[..., tuple[Any, ...]]  # LAPACK's solver (SciPy's), as numpy.linalg.solve
+    weights: tuple[FloatArray, FloatArray]  # of the task error, and of the Jacobian's rows
+    damping: FloatArray
+    reach: tuple[FloatArray, FloatArray, float]  # the limits' lower and upper bounds, gain
 
 
 def box_qp(hessian: FloatArray, b: FloatArray, low: FloatArray, high: FloatArray) -> FloatArray:

@@ -3,15 +3,18 @@
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from dial.haptics import FitError, PlaneFit, SuperquadricFit
 from dial.instructions.types import FINGERS, Contact
 from dial.primitives.context import Context, RobotPrimitive, done, missed
 from dial.robot.contact import force_reading, position_reading, tactile_reading
 from dial.robot.snapshot import FloatArray, Snapshot
 from dial.scheduler.primitive import Allotment, Ended, Now, Outcome
+
+if TYPE_CHECKING:
+    from dial.haptics import PlaneFit, SuperquadricFit
 
 
 class Get:
@@ -151,6 +154,8 @@ class Fit:
         self.ctx, self.set, self.fit, self.object = ctx, point_set, fit, learns
 
     def sense(self, snapshot: Snapshot) -> Ended:
+        from dial.haptics import FitError, PlaneFit  # SciPy: only a run that fits loads it
+
         points = np.array(self.ctx.point_sets.get(self.set, []), dtype=np.float64).reshape(-1, 3)
         try:
             fit = self.fit(points)

@@ -26,6 +26,7 @@ of frames: one call per entity per batch keeps the cost per frame to an array co
 
 from __future__ import annotations
 
+import dataclasses
 import socket
 from collections.abc import Mapping, Sequence
 from pathlib import Path
@@ -39,8 +40,9 @@ from dial.backend.model import FINGERS, default_profile
 from dial.errors import DialError
 from dial.recording import layout
 from dial.recording.frames import Batch
-from dial.recording.geometry import Shape, body_paths, moving_bodies, shapes, superquadric_mesh
-from dial.recording.lanes import STATE_COLORS, LanePlan, Lanes, Phase
+from dial.recording.geometry import body_paths, moving_bodies, shapes, superquadric_mesh
+from dial.recording.lanes import STATE_COLORS, Lane, LanePlan, Lanes, Phase
+from dial.recording.rerun_shapes import SOLID, archetype, quat
 from dial.recording.styles import (
     EXTENSOR_SHADE,
     JOINT_COLORS,
@@ -61,7 +63,6 @@ TACTILE_GAP = 3  # taxels between two fingertips' images
 GUARD_COLOR, POINT_COLOR, FIT_COLOR = (255, 80, 40), (40, 160, 255), (255, 200, 0, 140)
 GUARD_SHOWN_S = 2.0  # simulated seconds a guard's contact marker stays
 LEVELS = {"info": "INFO", "warn": "WARN", "error": "ERROR"}  # rerun's TextLogLevel
-SOLID = rr.components.FillMode.Solid
 PLANE_THICKNESS = 1e-3  # m, to draw a fitted plane as a thin box
 VIEWER_PORT = 9876  # rerun's default
 FLUSH_TIMEOUT_S = 10.0
@@ -73,39 +74,6 @@ def _listening(port: int) -> bool:
     except OSError:
         return False
     return True
-
-
-def _rgba(rgba: FloatArray) -> np.ndarray:
-    return np.asarray(np.round(np.clip(rgba, 0.0, 1.0) * 255), dtype=np.uint8)
-
-
-def _quat(wxyz: FloatArray) -> rr.Quaternion:
-    """MuJoCo's (w, x, y, z) as rerun's quaternion, stored (x, y, z, w)."""
-    return rr.Quaternion(xyzw=[wxyz[1], wxyz[2], wxyz[3], wxyz[0]])
-
-
-def _archetype(shape: Shape) -> Any:
-    color = _rgba(shape.rgba)
-    r, half = float(shape.size[0]), float(shape.size[1])
-    if shape.kind == "box":
-        return rr.Boxes3D(half_sizes=[shape.size], colors=color, fill_mode=SOLID)
-    if shape.kind in ("sphere", "ellipsoid"):
-        size = [r, r, r] if shape.kind == "sphere" else shape.size
-        return rr.Ellipsoids3D(half_sizes=[size], colors=color, fill_mode=SOLID)
-    if shape.kind == "capsule":  # rerun's capsule starts at the origin; MuJoCo's is centred
-        return rr.Capsules3D(
-            lengths=[2 * half],
-            radii=[r],
-            translations=[[0.0, 0.0, -half]],
-            colors=color,
-            fill_mode=SOLID,
-        )
-    if shape.kind == "cylinder":
-        return rr.Cylinders3D(lengths=[2 * half], radii=[r], colors=color, fill_mode=SOLID)
-    assert shape.vertices is not None and shape.faces is not None
-    return rr.Mesh3D(
-        vertex_positions=shape.vertices, triangle_indices=shape.faces, albedo_factor=color
-    )
 
 
 class RerunSink:
@@ -162,9 +130,7 @@ class RerunSink:
         rec = self.rec
         self._profile = default_profile() if profile is None else profile
         self.lanes = Lanes(plan)
-        self._at(0.0, 0)
-        for key in self.lanes.plan.order:  # one lane per event, also for one that never runs
-            self.rec.log(self._lane(self.lanes.path(key)), rr.StateChange.cleared())
+        self.open_lanes(self.lanes)
         self._task = [f"{layout.TASK}/{s.name}" for s in task]
         rec.send_recording_name(title)
         titles = [(s.name, f"{s.label} ({s.unit})") for s in task]
@@ -176,11 +142,11 @@ class RerunSink:
         self._bodies = [paths[b] for b in sorted(moving)]
         for b in range(1, model.nbody):
             if b not in moving:
-                pose = rr.Transform3D(translation=data.xpos[b], quaternion=_quat(data.xquat[b]))
+                pose = rr.Transform3D(translation=data.xpos[b], quaternion=quat(data.xquat[b]))
                 rec.log(paths[b], pose, static=True)
         for shape in shapes(model):
-            pose = rr.Transform3D(translation=shape.pos, quaternion=_quat(shape.quat))
-            rec.log(f"{paths[shape.body]}/{shape.name}", pose, _archetype(shape), static=True)
+            pose = rr.Transform3D(translation=shape.pos, quaternion=quat(shape.quat))
+            rec.log(f"{paths[shape.body]}/{shape.name}", pose, archetype(shape), static=True)
         self._styles(task)
         self._tactile_key()
 
@@ -282,7 +248,7 @@ class RerunSink:
         scalars(layout.ARM_JOINTS, batch.arm)
         for s, path in enumerate(self._task):
             scalars(path, batch.task[:, s : s + 1])
-        self._phases(self.lanes.flush(float(batch.time_ns[-1]) * 1e-9))
+        self.phases(self.lanes.flush(float(batch.time_ns[-1]) * 1e-9))
         self._send_events()
 
     def _send_events(self) -> None:
@@ -310,14 +276,13 @@ class RerunSink:
         self._at(t, tick)
         described = describe(record)
         if described is not None:
-            text, level = described
-            self._lines.append((round(t * 1e9), tick, text, LEVELS[level]))
+            self.line(t, tick, *described)
         kind = record["kind"]
         if kind == "end":
             self._sensed(record.get("data", {}))
         elif kind == "contact" and tips is not None:
             self._guard(record, tips[FINGERS.index(record["finger"])], t, tick)
-        self._phases(self.lanes.feed(record))
+        self.phases(self.lanes.feed(record))
 
     def _at(self, t: float, tick: int) -> None:
         self.rec.set_time("sim_time", duration=np.timedelta64(round(t * 1e9), "ns"))
@@ -336,10 +301,18 @@ class RerunSink:
             self.rec.log(path, config, static=True)
         return path
 
-    def _phases(self, phases: list[Phase]) -> None:
-        """Lane changes, each at its own time; a lane's first change brings its colours."""
+    def open_lanes(self, lanes: Lanes, under: Lane = ()) -> None:
+        """One lane per event of the plan (under the path ``under``), empty from time 0,
+        also for an event that never runs."""
+        self._at(0.0, 0)
+        for key in lanes.plan.order:
+            self.rec.log(self._lane((*under, *lanes.path(key))), rr.StateChange.cleared())
+
+    def phases(self, phases: list[Phase], under: Lane = ()) -> None:
+        """Lane changes, each at its own time, under the path ``under``; a lane's first
+        change brings its colours."""
         for phase in phases:
-            path = self._lane(phase.lane)
+            path = self._lane((*under, *phase.lane))
             self._at(phase.t, phase.tick)
             state = (
                 rr.StateChange.cleared()
@@ -392,8 +365,29 @@ class RerunSink:
                 ),
             )
 
+    # -- a second robot: a remote run's reported one, beside the predicted (docs/remote.md) --
+    def ghost(self, model: mujoco.MjModel, paths: Mapping[int, str], color: FloatArray) -> None:
+        """The geometry of the bodies in ``paths`` again, under those entity paths, all in
+        ``color`` (RGBA, 0-1)."""
+        for shape in shapes(model):
+            if shape.body in paths:
+                pose = rr.Transform3D(translation=shape.pos, quaternion=quat(shape.quat))
+                drawn = archetype(dataclasses.replace(shape, rgba=color))
+                self.rec.log(f"{paths[shape.body]}/{shape.name}", pose, drawn, static=True)
+
+    def poses(self, t: float, tick: int, paths: Mapping[int, str], data: mujoco.MjData) -> None:
+        """Those bodies' poses at simulated time ``t`` and ``tick``."""
+        self._at(t, tick)
+        for b, path in paths.items():
+            pose = rr.Transform3D(translation=data.xpos[b], quaternion=quat(data.xquat[b]))
+            self.rec.log(path, pose)
+
+    def line(self, t: float, tick: int, text: str, level: str) -> None:
+        """A line of the text log (level: info, warn, error), sent with the next batch."""
+        self._lines.append((round(t * 1e9), tick, text, LEVELS[level]))
+
     def close(self) -> None:
-        self._phases(self.lanes.flush())
+        self.phases(self.lanes.flush())
         self._send_events()
         # A viewer closed mid-run must not keep the run from ending.
         self.rec.flush(timeout_sec=FLUSH_TIMEOUT_S if self.live else 1e38)

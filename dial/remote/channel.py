@@ -30,6 +30,7 @@ from dial.remote.protocol import (
 
 CONNECT_S = 15.0  # how long the first connection may take (hello and welcome included)
 RETRY_S = 0.1  # between reconnection attempts
+RECONNECT_S = 1.0  # the least time a reconnection attempt may take
 HEARTBEAT_S = 0.25
 GONE = (OSError, HandshakeError, ConnectionClosed, trio.BrokenResourceError)
 FATAL = frozenset({"token", "busy", "no_session", "version"})
@@ -57,6 +58,7 @@ class Channel:
     seq: int = 0
     sent_bytes: int = 0
     received_bytes: int = 0
+    telemetry: int = 0  # samples received
     rtt: float | None = None
     lost: str | None = None
     done: bool = False  # the session is over: stop reconnecting
@@ -90,11 +92,21 @@ class Channel:
     async def wait_welcome(self) -> None:
         await self._welcome.wait()
 
+    def _attempt_s(self) -> float:
+        """How long one connection attempt may take: CONNECT_S for the first; after a cut
+        a few round trips (at least RECONNECT_S). An attempt whose connection the far end
+        accepts and then drops before the handshake's reply (a gateway, a half-up link)
+        fails only at this timeout (trio-websocket waits for the reply): it must leave
+        time for more attempts within the watchdog time."""
+        if self.rtt is None or not self._welcome.is_set():
+            return CONNECT_S
+        return max(RECONNECT_S, 3.0 * self.rtt)
+
     async def _connect(self) -> None:
         async with open_websocket_url(
             self.url,
             max_message_size=MAX_FRAME,
-            connect_timeout=CONNECT_S,
+            connect_timeout=self._attempt_s(),
             disconnect_timeout=CLOSE_S,
         ) as ws:
             hello: dict[str, object] = {"token": self.token, "role": "operator"}
@@ -142,6 +154,7 @@ class Channel:
         elif kind == "pong":
             self._pong.set()
         elif kind == "telemetry":
+            self.telemetry += 1
             self.on_telemetry(msg)
         elif kind == "error":
             self.link_record("error", code=msg.text("code"), message=msg.text("message"))

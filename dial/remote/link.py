@@ -161,7 +161,7 @@ class Link:
                 nursery.start_soon(self._watch_cut, nursery.cancel_scope)
                 nursery.start_soon(self._pump, client, server, self.up, nursery.cancel_scope)
                 nursery.start_soon(self._pump, server, client, self.down, nursery.cancel_scope)
-        except (ConnectionClosed, HandshakeError, OSError, trio.BrokenResourceError):
+        except* (ConnectionClosed, HandshakeError, OSError, trio.BrokenResourceError):
             pass  # either end went away, or the server refused: the client sees it closed
         finally:
             with trio.CancelScope(shield=True), trio.move_on_after(CLOSE_S):
@@ -184,7 +184,7 @@ class Link:
     ) -> None:
         send, receive = trio.open_memory_channel[tuple[float, str | bytes]](math.inf)
         async with trio.open_nursery() as nursery:
-            nursery.start_soon(self._deliver, receive, dest)
+            nursery.start_soon(self._deliver, receive, dest, scope)
             try:
                 while True:
                     message = await source.get_message()
@@ -201,12 +201,19 @@ class Link:
         self,
         receive: trio.MemoryReceiveChannel[tuple[float, str | bytes]],
         dest: WebSocketConnection,
+        scope: trio.CancelScope,
     ) -> None:
+        """Deliver each message at its time; an end gone away ends the connection (what
+        was still on its way is lost, as on a real link)."""
         async for at, message in receive:
             await trio.sleep_until(at)
             if self.blackholed():
                 continue
-            await dest.send_message(message)
+            try:
+                await dest.send_message(message)
+            except (ConnectionClosed, trio.BrokenResourceError):
+                scope.cancel()
+                return
 
 
 async def serve_link(

@@ -13,7 +13,7 @@ from __future__ import annotations
 import json
 import time
 from dataclasses import dataclass
-from typing import TextIO
+from typing import TYPE_CHECKING, TextIO
 
 import trio
 
@@ -31,6 +31,9 @@ from dial.scheduler.log import EventLog, Record
 from dial.scheduler.runner import Tally
 from dial.scheduler.signals import StopRequest
 from dial.scheduler.types import RunAborted
+
+if TYPE_CHECKING:
+    from dial.remote.record import RemoteRecorder
 
 PREDICTION_WAIT_S = 10.0  # how long a finished run waits for its prediction to catch up
 STOP_WAIT_S = 1.0  # after the watchdog time, how long a stopped robot may take to report
@@ -77,6 +80,7 @@ class Operator:
         # (script, event) -> the outcome of its latest run, as reported (what a condition reads)
         self.latest: dict[tuple[str, str], str] = {}
         self.predictor: Predictor | None = None
+        self.recorder: RemoteRecorder | None = None  # --record, --rerun: the robots drawn
 
         self.channel = Channel(
             options.url,
@@ -88,8 +92,10 @@ class Operator:
         )
 
     def link(self, kind: str, /, **fields: object) -> None:
-        """A link record in the operator's log."""
+        """A link record in the operator's log (a ``diverged`` one also in the recording)."""
         self.out.link(kind, **fields)
+        if kind == "diverged" and self.recorder is not None:
+            self.recorder.diverged(fields)
 
     # -- reports ---------------------------------------------------------------------------------
     def _report(self, msg: Message) -> None:
@@ -144,10 +150,14 @@ class Operator:
                 self.options.progress(tick, float(t), sorted(self.running.values()))
         if self.predictor is not None:
             self.predictor.reported(record)
+        if self.recorder is not None:
+            self.recorder.record(record)
 
     def _telemetry(self, msg: Message) -> None:
         if self.predictor is not None:
             self.predictor.telemetry(msg)
+        if self.recorder is not None:
+            self.recorder.sample(msg.fields)
 
     async def result_of(self, seq: int) -> Message:
         """Wait for the robot's result (or refusal) of command ``seq``."""
@@ -225,8 +235,10 @@ def summary_record(op: Operator, wall: float) -> Record:
         "session": ch.session,
         "sent_bytes": ch.sent_bytes,
         "received_bytes": ch.received_bytes,
+        "telemetry": ch.telemetry,
         "rtt": None if ch.rtt is None else round(ch.rtt, 3),
         "link": None if op.options.link is None else op.options.link.text(),
+        "lead": next((r.get("seconds") for r in op.out.log.of("lead")), None),
         "diverged": len(op.out.log.of("diverged")),
         "late": len(op.out.log.of("late")),
     }
@@ -236,22 +248,29 @@ def summary_record(op: Operator, wall: float) -> Record:
 async def operate(script: Script, options: OperatorOptions, stop: StopRequest) -> RemoteResult:
     """Run ``script`` at the remote robot; a stop signal stops the robot (it holds)."""
     op = Operator(script, options)
+    if options.record is not None or options.rerun:  # before connecting: a viewer takes time
+        from dial.remote.record import remote_recorder
+
+        op.recorder = remote_recorder(script, options.record, options.rerun)
     start = time.perf_counter()
     message: str | None = None
-    async with trio.open_nursery() as nursery:
-        if options.link is not None:
-            link = Link(options.link, options.url)
-            port = await nursery.start(serve_link, link, "127.0.0.1", 0)
-            op.channel.url, op.channel.shown = f"ws://127.0.0.1:{port}/", options.url
-        with trio.CancelScope() as work:
-            nursery.start_soon(op.channel.run, work)
-            nursery.start_soon(_watch_stop, op, stop, work)
-            message = await _session(script, op)
-        op.channel.done = True
-        nursery.cancel_scope.cancel()
+    try:
+        async with trio.open_nursery() as nursery:
+            if options.link is not None:
+                link = Link(options.link, options.url)
+                port = await nursery.start(serve_link, link, "127.0.0.1", 0)
+                op.channel.url, op.channel.shown = f"ws://127.0.0.1:{port}/", options.url
+            with trio.CancelScope() as work:
+                nursery.start_soon(op.channel.run, work)
+                nursery.start_soon(_watch_stop, op, stop, work)
+                message = await _session(script, op)
+            op.channel.done = True
+            nursery.cancel_scope.cancel()
+    finally:
+        if op.recorder is not None:
+            op.recorder.over()  # nothing more comes: the recording may close
     wall = time.perf_counter() - start
-    if op.predictor is not None:
-        op.predictor.finish(PREDICTION_WAIT_S if op.finished is not None else 0.0)
+    _end_prediction(op)
     if op.channel.lost is not None and op.finished is None:
         message = op.channel.lost
         op.out.link("lost", message=message)
@@ -263,11 +282,23 @@ async def operate(script: Script, options: OperatorOptions, stop: StopRequest) -
     return RemoteResult(result, record, message or op.rejected, stop.signal)
 
 
+def _end_prediction(op: Operator) -> None:
+    """Give a finished run's prediction time to get there, stop it; the recording closes
+    in the prediction's thread, or here when that thread never began it (one writer)."""
+    predictor, recorder = op.predictor, op.recorder
+    if predictor is not None:
+        predictor.finish(PREDICTION_WAIT_S if op.finished is not None else 0.0)
+    thread = None if predictor is None else predictor.thread
+    if recorder is not None and (thread is None or not thread.is_alive()):
+        recorder.close()
+
+
 async def _session(script: Script, op: Operator) -> str | None:
     options = op.options
     await op.channel.wait_welcome()
     if options.predict:
-        op.predictor = start_prediction(script, options.tick, op.link, options.diverge_mm)
+        watching = [] if op.recorder is None else [op.recorder]
+        op.predictor = start_prediction(script, options.tick, op.link, options.diverge_mm, watching)
     try:
         await run_split(script, op)
         if op.rejected is not None:  # the script does not check in the robot's world

@@ -3,7 +3,8 @@
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
+from pathlib import Path
 from typing import TextIO
 
 from dial.remote.link import LinkSpec
@@ -25,4 +26,6 @@ class OperatorOptions:
     log: TextIO | None = None
     progress: Progress | None = None
     predict: bool = True
-    observers: list[object] = field(default_factory=list)
+    record: Path | None = None  # --record: the predicted and the reported robot, a .rrd file
+    rerun: bool = False  # --rerun: the same, live in a spawned viewer
+    quiet: bool = False  # --quiet: say nothing but errors

@@ -57,7 +57,7 @@ class Predictor:
         self._sample()
 
     def end(self, result: RunResult | None) -> None:
-        pass
+        self.done.set()  # its log is complete (a recorder after it may go on drawing reports)
 
     def _sample(self) -> None:
         d, ix = self.robot.data, self.robot.index

@@ -73,7 +73,8 @@ def robot_main(session: Session, config: RobotConfig, first: Message, every: int
             except DialError as e:
                 _reject(session, seq, ident, str(e))
                 return
-            session.state = "running"
+            if session.state == "ready":  # (not lost while it was being checked)
+                session.state = "running"
             session.report("result", seq=seq, id=ident, tick=0, checked=True)
             result = _run(session, config, first, script, telemetry)
     except DialError as e:  # a scene that cannot be set up, a log that cannot be written

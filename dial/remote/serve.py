@@ -105,5 +105,8 @@ def run_remote(
         log=log,
         progress=progress,
         predict=not args.no_predict,
+        record=None if args.record is None else Path(args.record),
+        rerun=args.rerun,
+        quiet=args.quiet,
     )
     return trio.run(operate, script, options, stop)

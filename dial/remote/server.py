@@ -55,6 +55,11 @@ class Conn:
     async def send(self, text: str) -> None:
         await self.ws.send_message(text)
 
+    def close(self) -> None:
+        """Close this connection soon (its sender closes it, also while it is silent)."""
+        self.closing = True
+        self.woken.set()
+
 
 class Server:
     """The robot's server: sessions, their watchdogs, and every connection's messages."""
@@ -129,6 +134,9 @@ class Server:
             self.conns.discard(conn)
             if self.controller is conn:
                 self.controller = None  # the session waits for its operator: the watchdog runs
+                s = conn.session
+                if s is not None and s.active:  # a cut, a dead operator: said in the log
+                    s.link_record("disconnected", session=s.number, tick=s.tick)
             with trio.CancelScope(shield=True), trio.move_on_after(CLOSE_S):
                 await conn.ws.aclose()
 
@@ -153,14 +161,16 @@ class Server:
 
     async def _sender(self, conn: Conn) -> None:
         """Reports (each once, in order), the latest telemetry, and heartbeats; until the
-        connection closes."""
+        connection closes, or is to be closed: then close it."""
         with contextlib.suppress(ConnectionClosed, trio.BrokenResourceError):
             await self._send_all(conn)
         conn.closing = True
+        with trio.move_on_after(CLOSE_S):
+            await conn.ws.aclose()
 
     async def _send_all(self, conn: Conn) -> None:
         due = trio.current_time()
-        while True:
+        while not conn.closing:
             conn.woken = trio.Event()  # before sending: a wake meanwhile is not lost
             s = conn.session
             if s is not None and conn is self.controller:
@@ -220,7 +230,7 @@ class Server:
             return False
         old = self.controller
         if old is not None and old is not conn:
-            old.closing = True  # the same operator again, after a cut its old socket missed
+            old.close()  # the same operator again, after a cut its old socket missed
             with trio.CancelScope(shield=True), trio.move_on_after(CLOSE_S):
                 await old.ws.aclose()
         conn.session, conn.sent = s, msg.integer("have")
@@ -256,17 +266,17 @@ class Server:
     def _lose(self, s: Session, why: str) -> None:
         s.link_record("lost", message=why, tick=self._tick())
         s.stop.request("link lost")
+        s.state = "lost"  # the robot holds at its next control period
         if s.thread is None:  # nothing ran: the session ends here
-            s.state = "lost"
             s.report("finished", summary={"ok": False, "interrupted": "link lost"})
         print(f"dial serve: session {s.number}: {why}; every effector holds", file=sys.stderr)
         if self.controller is not None:
-            self.controller.closing = True
+            self.controller.close()
             self.controller = None
 
     async def _close(self, conn: Conn, code: str, why: str) -> None:
         await conn.send(error(code, why))
-        conn.closing = True
+        conn.close()
 
     # -- commands ------------------------------------------------------------------------------
     async def _command(self, conn: Conn, msg: Message) -> None:

@@ -25,12 +25,17 @@ from dial.remote.protocol import Message, encode
 from dial.scheduler.log import Record
 from dial.scheduler.signals import StopRequest
 
-# Record kinds that only the link writes: they hold wall times, and a comparison of a
-# remote robot's log with a local run's leaves them out (docs/remote.md).
 PERIOD = 0.01  # s, the control period
 
+# Record kinds that only the link writes, at the robot and at the operator: they hold wall
+# times, and a comparison of a remote robot's log with a local run's leaves them out
+# (docs/remote.md, Records).
 LINK_RECORDS = frozenset(
-    {"session", "received", "sent", "acknowledged", "reported", "late", "lost", "diverged"}
+    {
+        *("session", "disconnected", "received", "lost"),  # the robot's
+        *("connected", "rtt", "lead", "sent", "acknowledged", "reported"),  # the operator's
+        *("late", "refused", "diverged", "error"),
+    }
 )
 
 

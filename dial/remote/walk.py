@@ -16,11 +16,21 @@ from __future__ import annotations
 import json
 import math
 import os
+import sys
 from pathlib import Path
 from typing import Protocol
 
 from dial.errors import DialError
-from dial.parser.script import Script, Step, TBlock, TCall, TIf, TRepeat, scripts_of
+from dial.parser.script import (
+    Script,
+    Step,
+    TBlock,
+    TCall,
+    TIf,
+    TRepeat,
+    iter_steps,
+    scripts_of,
+)
 from dial.remote.blocks import describe
 from dial.remote.channel import Channel
 from dial.remote.options import OperatorOptions
@@ -42,7 +52,10 @@ class Station(Protocol):
     async def next_report(self) -> None: ...
 
 
-LEAD_MARGIN_S = 0.2  # s added to 1.5 round trips for the default lead
+LEAD_TRIPS = 1.5  # the default lead: this many round trips and LEAD_MARGIN_S,
+LEAD_MARGIN_S = 0.2  # s
+LEAD_GRID_S = 0.5  # rounded up to 0.5, 1, 2, 4, 8... s when the round trip is measured
+ENVELOPE_BYTES = 160  # a block command's fields besides its block, about
 
 
 async def run_split(script: Script, op: Station) -> None:
@@ -56,7 +69,7 @@ async def run_split(script: Script, op: Station) -> None:
         return
     seq = await ch.command("open", script=upload(script), tick_length=tick)
     _accepted(await op.result_of(seq))
-    walker = Walker(op, seq, lead_ticks(op, rtt))
+    walker = Walker(op, seq, lead_ticks(op, rtt, script))
     try:
         await walker.walk(script, script.timeline)
     except _Max as e:
@@ -72,16 +85,56 @@ def _accepted(result: Message) -> None:
         raise DialError(f"the robot refused the script: {result.text('message')}")
 
 
-def lead_ticks(op: Station, rtt: float) -> int:
-    """``--lead`` in ticks of the robot's paced time; by default 1.5 round trips and a
-    margin (give ``--lead`` for runs that must tag the same ticks)."""
+def lead_ticks(op: Station, rtt: float, script: Script) -> int:
+    """``--lead`` in ticks of the robot's paced time (default: :func:`default_lead`),
+    logged, and said unless ``--quiet`` so that a user can pin it."""
     pace = op.channel.robot.get("pace", 1.0)
     wall_per_tick = op.options.tick * (float(pace) if isinstance(pace, int | float) else 1.0)
     given = op.options.lead
-    seconds = given if given is not None else 1.5 * rtt + LEAD_MARGIN_S
-    ticks = max(1, math.ceil(seconds / wall_per_tick))
-    op.link("lead", seconds=round(seconds, 4), ticks=ticks)
+    seconds, why = (given, "--lead") if given is not None else default_lead(op, rtt, script)
+    ticks = max(1, math.ceil(round(seconds / wall_per_tick, 9)))
+    op.link("lead", seconds=round(seconds, 4), ticks=ticks, source=why)
+    if given is None and not op.options.quiet:
+        print(
+            f"dial: --split block: the lead is {seconds:g} s ({ticks} ticks at the robot), "
+            f"{why}; '--lead {seconds:g}' gives it again",
+            file=sys.stderr,
+        )
     return ticks
+
+
+def default_lead(op: Station, rtt: float, script: Script) -> tuple[float, str]:
+    """LEAD_TRIPS round trips and LEAD_MARGIN_S (s), and where the round trip comes from.
+
+    With ``--link`` the round trip is the emulated link's worst, two delays and two
+    jitters, plus sending the script's largest block at its bandwidth: the same in every
+    run. Without, it is the ping measured at connect, which jitter and load vary from run
+    to run: the lead is then rounded up to the grid 0.5, 1, 2, 4... s, so that two runs
+    through the same link tag the same ticks (unless the round trip lies at a step).
+    """
+    spec = op.options.link
+    if spec is not None:
+        trip = 2.0 * (spec.delay + spec.jitter)
+        if spec.bandwidth is not None:
+            trip += 8.0 * (largest_block(script) + ENVELOPE_BYTES) / spec.bandwidth
+        return round(LEAD_TRIPS * trip + LEAD_MARGIN_S, 3), "from the --link spec"
+    seconds = LEAD_GRID_S
+    while seconds < LEAD_TRIPS * rtt + LEAD_MARGIN_S:
+        seconds *= 2.0
+    return seconds, f"from the round trip of {rtt:.3f} s measured at connect"
+
+
+def largest_block(script: Script) -> int:
+    """The bytes of the script's largest block description (of it and what it calls)."""
+    return max(
+        (
+            len(json.dumps(describe(s, step)))
+            for s in scripts_of(script)
+            for step in iter_steps(s.timeline)
+            if isinstance(step, TBlock)
+        ),
+        default=0,
+    )
 
 
 def upload(script: Script) -> dict[str, object]:

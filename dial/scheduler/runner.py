@@ -9,13 +9,11 @@ clock and the table of active runs. Every record goes through
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import Generic
 
 import trio
 
-from dial.errors import DialError
 from dial.parser.ast import Condition
 from dial.parser.script import (
     Run,
@@ -36,7 +34,7 @@ from dial.scheduler.primitive import Outcome
 from dial.scheduler.records import Records
 from dial.scheduler.signals import StopRequest
 from dial.scheduler.ticks import Observe, Progress, TickLoop
-from dial.scheduler.types import Interrupted, PrimitiveFactory, RunAborted, S
+from dial.scheduler.types import Interrupted, PrimitiveFactory, RunAborted, S, periods_per_tick
 
 Ending = TResume | TRetry | TAbort  # how a reaction ends, once one of these is executed
 
@@ -58,13 +56,6 @@ class Tally:
     tick_length: float
     outcomes: dict[str, int]
     interrupted: str | None = None
-
-
-def periods_per_tick(tick: float, period: float) -> int:
-    """Ticks are whole numbers of control periods."""
-    if not math.isfinite(tick) or round(tick / period) < 1:
-        raise DialError(f"tick length {tick:g} s is shorter than the control period {period:g} s")
-    return round(tick / period)
 
 
 class Runner(Generic[S]):

@@ -8,6 +8,7 @@ for zero-length sensing) made through its :class:`Makers`.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Protocol, TypeVar
 
@@ -17,6 +18,15 @@ from dial.scheduler.primitive import Allotment, Primitive, Sensor
 
 S = TypeVar("S")
 S_contra = TypeVar("S_contra", contravariant=True)
+
+DEFAULT_TICK = 0.25  # s, when neither the script (@tick) nor the command line sets one
+
+
+def periods_per_tick(tick: float, period: float) -> int:
+    """Ticks are whole numbers of control periods."""
+    if not math.isfinite(tick) or round(tick / period) < 1:
+        raise DialError(f"tick length {tick:g} s is shorter than the control period {period:g} s")
+    return round(tick / period)
 
 
 @dataclass(frozen=True)

@@ -17,7 +17,7 @@ from typing import Any
 import mujoco
 import numpy as np
 
-from dial.backend.model import load_model
+from dial.backend.model import load_model, profile_at
 from dial.geometry import matrix_rpy
 from dial.recording.timeline import read_log
 from dial.scene.belief import initial
@@ -57,7 +57,10 @@ def believed_from_log(path: Path) -> str:
 def _world_path(world: str) -> Path:
     """The world file a ``scene`` record names: a bundled file's name, else its path."""
     path = Path(world)
-    return path if path.is_absolute() else worlds_dir() / path
+    if path.is_absolute():
+        return path
+    # "pour.toml" is the default robot's; "allegro_panda/pour.toml" another bundled robot's.
+    return worlds_dir(*path.parts[:-1]) / path.name
 
 
 def _cells(entry: Mapping[str, Any]) -> list[str]:
@@ -90,7 +93,7 @@ def _row(alias: str, entry: Mapping[str, Any]) -> list[str]:
 
 def _at_start(world: World, shift: np.ndarray) -> list[list[str]]:
     """Believed (as at load) and true (the model's pose, perturbed) rows of every object."""
-    model = load_model(world.model_path)
+    model = load_model(world.model_path, profile_at(world.robot))
     data = mujoco.MjData(model)
     mujoco.mj_forward(model, data)
     poses = {}

@@ -59,6 +59,7 @@ class FakeRobot:
         self._keys = itertools.count(1)
         self.stops: list[str] = []  # events whose run was stopped, in order
         self.coasts: list[tuple[int, int]] = []  # each coast's first period and length asked
+        self.lag = 0.0  # trio (mock clock) s that each period takes: a slow robot
 
     @property
     def period(self) -> float:
@@ -68,6 +69,10 @@ class FakeRobot:
         return FakeSnapshot(self.periods, MappingProxyType(self.commands.copy()))
 
     def advance(self) -> Report | None:
+        if self.lag:
+            clock = trio.lowlevel.current_clock()
+            assert isinstance(clock, trio.testing.MockClock)
+            clock.jump(self.lag)
         self.trace.append(self.commands.copy())
         self.periods = periods = self.periods + 1
         fault = self.fault_at.get(periods) if self.fault_at else None
@@ -232,18 +237,21 @@ def run_fake(
     fault_at: Mapping[int, str] | None = None,
     holds: Mapping[str, Collection[int]] | None = None,
     paced: bool = True,
+    lag: float = 0.0,
 ) -> FakeResult:
     """Check ``script`` (text or checked script) and run it on a fake robot.
 
     ``paced``: the runner keeps pace with trio's clock, a ``MockClock`` here, as
     ``--realtime`` does with the wall clock; so trio's (virtual) time ends equal to the
-    simulated time. Unpaced, it runs as ``dial run`` does, as fast as it can.
+    simulated time. Unpaced, it runs as ``dial run`` does, as fast as it can. ``lag``: the
+    (virtual) time each period takes the robot; over a period, a paced run falls behind.
     """
     if isinstance(script, str):
         checked = check_text(script, path)
         assert checked is not None
         script = checked
     robot = FakeRobot(period, fault_at, holds)
+    robot.lag = lag
     log = EventLog()
     factory = FakeFactory(robot, behaviours or {})
     runner = Runner(robot, factory, tick, log, pace=1.0 if paced else None)

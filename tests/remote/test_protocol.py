@@ -90,3 +90,22 @@ def test_token_files_are_private(tmp_path: object) -> None:
         read_token(path)
     with pytest.raises(DialError, match="no token file"):
         read_token(path.with_name("missing"))
+
+
+def test_nothing_is_unpickled_nor_evaluated() -> None:
+    """JSON is the only encoding: no module of the remote side imports pickle, marshal or
+    shelve, or calls eval or exec."""
+    import ast
+    from pathlib import Path
+
+    from dial.remote import protocol
+
+    paths = sorted(Path(protocol.__file__).parent.glob("*.py"))
+    assert len(paths) > 10
+    for path in paths:
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.Import | ast.ImportFrom):
+                names = [a.name for a in node.names] + [getattr(node, "module", None) or ""]
+                assert not {"pickle", "marshal", "shelve", "dill"} & set(names), path
+            if isinstance(node, ast.Call) and isinstance(node.func, ast.Name):
+                assert node.func.id not in ("eval", "exec"), path
