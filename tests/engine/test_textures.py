@@ -36,7 +36,9 @@ def test_a_run_without_textures_is_the_run_with_them(
     untextured: list[str] = []
     compile_bare = model.load_untextured
     monkeypatch.setattr(
-        model, "load_untextured", lambda path: untextured.append(str(path)) or compile_bare(path)
+        model,
+        "load_untextured",
+        lambda path, profile=None: untextured.append(str(path)) or compile_bare(path, profile),
     )
     bare = dial.run(short_script, perturb=5, seed=2)
     assert [Path(p).name for p in untextured] == ["scene_surface.xml"]
