@@ -127,8 +127,8 @@ def _run_keeping(script: Script) -> tuple[RunResult, tuple[mujoco.MjModel, mujoc
     kept: list[tuple[mujoco.MjModel, mujoco.MjData]] = []
     original = engine_run.prepare
 
-    def prepare(*args: Any) -> tuple[driver.MujocoRobot, Any]:
-        robot, ctx = original(*args)
+    def prepare(*args: Any, **kwargs: Any) -> tuple[driver.MujocoRobot, Any]:
+        robot, ctx = original(*args, **kwargs)
         kept.append((robot.model, robot.data))
         return robot, ctx
 
