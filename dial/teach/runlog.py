@@ -21,7 +21,7 @@ from dial.backend.model import load_model, profile_at
 from dial.geometry import matrix_rpy
 from dial.recording.timeline import read_log
 from dial.scene.belief import initial
-from dial.scene.resolve import worlds_dir
+from dial.scene.resolve import bundled_world, worlds_dir
 from dial.scene.world import World, load_world
 from dial.teach.describe import columns
 from dial.teach.frames import deg_text, mm_text
@@ -60,7 +60,7 @@ def _world_path(world: str) -> Path:
     if path.is_absolute():
         return path
     # "pour.toml" is the default robot's; "allegro_panda/pour.toml" another bundled robot's.
-    return worlds_dir(*path.parts[:-1]) / path.name
+    return bundled_world(world.removesuffix(".toml")) or worlds_dir() / path
 
 
 def _cells(entry: Mapping[str, Any]) -> list[str]:
