@@ -10,7 +10,7 @@ for that sensor's estimate: it lies on the link's surface, within half the penet
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Collection, Sequence
 
 import mujoco
 import numpy as np
@@ -56,19 +56,40 @@ def link_point(
     return np.array(contacts.pos[deepest], dtype=np.float64)
 
 
-def fingers_touching(
-    model: mujoco.MjModel, data: mujoco.MjData, body: str, fingers: Sequence[frozenset[int]]
-) -> int:
-    """How many of ``fingers`` (each a finger's bodies) have a link in contact with the body
-    named ``body``."""
-    n = data.ncon
-    if n == 0:
-        return 0
-    target = int(mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, body))
-    b1 = model.geom_bodyid[data.contact.geom1[:n]]
-    b2 = model.geom_bodyid[data.contact.geom2[:n]]
-    other = np.concatenate([b2[b1 == target], b1[b2 == target]])
-    return sum(bool(np.isin(other, list(f)).any()) for f in fingers)
+_BODY = mujoco.mjtObj.mjOBJ_BODY
+
+
+class FingerContacts:
+    """Which of a robot's fingers touch a body. The world model asks before each primitive
+    while the hand holds something, so the fingers' links are one bit mask per body and the
+    bodies' ids are looked up once."""
+
+    def __init__(
+        self, model: mujoco.MjModel, data: mujoco.MjData, fingers: Sequence[Collection[int]]
+    ) -> None:
+        """``fingers``: each finger's bodies (ids), in the profile's finger order."""
+        self._model, self._data = model, data
+        owner = np.zeros(model.nbody, dtype=np.int64)
+        for k, bodies in enumerate(fingers):
+            owner[sorted(bodies)] |= 1 << k
+        self._owner = owner  # body id -> bit k set when the body is a link of finger k
+        self._ids: dict[str, int] = {}
+
+    def count(self, body: str, fingers: Sequence[int]) -> int:
+        """How many of ``fingers`` (indices in profile order) have a link in contact with the
+        body named ``body``."""
+        d = self._data
+        n = d.ncon
+        if n == 0:
+            return 0
+        target = self._ids.get(body)
+        if target is None:
+            target = self._ids[body] = mujoco.mj_name2id(self._model, _BODY, body)
+        of_geom = self._model.geom_bodyid
+        b1, b2 = of_geom[d.contact.geom1[:n]], of_geom[d.contact.geom2[:n]]
+        other = np.concatenate([b2[b1 == target], b1[b2 == target]])
+        bits = int(np.bitwise_or.reduce(self._owner[other])) if len(other) else 0
+        return sum((bits >> f) & 1 for f in fingers)
 
 
 UPRIGHT = 0.7  # a contact normal within 45 deg of vertical: one body rests on the other

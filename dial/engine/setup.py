@@ -14,7 +14,7 @@ import numpy as np
 from dial.backend.disturb import Disturbances
 from dial.backend.driver import MujocoRobot
 from dial.backend.ik import ArmIK, FingerIK
-from dial.backend.locate import fingers_touching, resting_on
+from dial.backend.locate import FingerContacts, resting_on
 from dial.backend.model import (
     RobotIndex,
     finger_bodies,
@@ -120,9 +120,9 @@ def feeling(robot: MujocoRobot) -> Feeling:
     """What the world model asks of the physics: which fingers touch an object, what rests
     on one (:mod:`dial.backend.locate`), and the time."""
     m, d = robot.model, robot.data
-    links = [frozenset(finger_bodies(m, f.joints)) for f in robot.index.profile.fingers]
+    links = [finger_bodies(m, f.joints) for f in robot.index.profile.fingers]
     return Feeling(
-        lambda body, fingers: fingers_touching(m, d, body, [links[f] for f in fingers]),
+        FingerContacts(m, d, links).count,
         lambda body: resting_on(m, d, body),
         lambda: robot.time,
     )
