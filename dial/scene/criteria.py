@@ -12,6 +12,7 @@ from collections.abc import Mapping
 from dataclasses import MISSING, Field, dataclass, field, fields
 from typing import Any, ClassVar, get_type_hints
 
+from dial.robots.fields import value_kind
 from dial.scene.reader import Reader
 
 FACES: tuple[str, ...] = ("+x", "-x", "+y", "-y", "+z", "-z")
@@ -123,7 +124,9 @@ def parse_criterion(
 ) -> Criterion:
     """Build one criterion from its TOML table; ``objects`` maps aliases to body names."""
     key = f"criteria.{name}"
-    table = reader.table(table, key)
+    if not isinstance(table, Mapping):
+        got = value_kind(table)
+        raise reader.error(key, f"expected a table, or false to drop an extended file's; got {got}")
     kind = reader.choice(table.get("kind"), f"{key}.kind", KINDS, "criterion kind")
     cls = KINDS[kind]
     hints = get_type_hints(cls)

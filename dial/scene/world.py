@@ -159,9 +159,11 @@ def load_world(path: Path) -> World:
         name: _program(reader, name, value, locations, robot)
         for name, value in reader.table(data.get("programs", {}), "programs").items()
     }
+    # `NAME = false` drops a criterion that an extended world file declares.
     criteria = tuple(
         parse_criterion(reader, _name(reader, "criteria", name), value, objects)
         for name, value in reader.table(data.get("criteria", {}), "criteria").items()
+        if value is not False
     )
     return World(
         name=bundled_name(path) or path.stem,

@@ -230,6 +230,17 @@ def test_thread_turns_are_a_world_setting_that_extends_inherits(tmp_path: Path) 
     assert world.thread_turns == 5.0 and world.model_path.name == "scene_lightbulb.xml"
 
 
+def test_false_drops_an_extended_criterion_and_true_is_an_error(tmp_path: Path) -> None:
+    base = [c.name for c in load_world(resolve_scene("pour", tmp_path)).criteria]
+    assert base == ["contents_in_cup", "pitcher_upright"]
+    dropped = write(tmp_path / "a.toml", 'extends = "pour"\n[criteria]\ncontents_in_cup = false\n')
+    assert [c.name for c in load_world(dropped).criteria] == ["pitcher_upright"]
+    kept = write(tmp_path / "b.toml", 'extends = "pour"\n[criteria]\ncontents_in_cup = true\n')
+    message = r"b.toml: criteria.contents_in_cup: expected a table, or false to drop an extended"
+    with pytest.raises(WorldFileError, match=message):
+        load_world(kept)
+
+
 def test_toml_syntax_error_names_the_file(tmp_path: Path) -> None:
     path = write(tmp_path / "bad.toml", "[scene\n")
     with pytest.raises(WorldFileError, match=r"bad.toml: invalid TOML: .*line 1"):
