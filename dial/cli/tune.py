@@ -106,8 +106,7 @@ def cmd_tune(args: argparse.Namespace) -> int:
         if Path(args.plot).suffix.lower() != ".png":
             raise UsageError(f"--plot writes a .png file, not '{args.plot}'")
         api.writable(args.plot, "the plot")
-    for spec in args.disturb:  # a bad SPEC is a usage error before anything runs
-        parse_disturbance(spec)
+    disturb = tuple(parse_disturbance(spec) for spec in args.disturb)  # before anything runs
     try:
         scene = None if args.scene is None else scene_option(args.scene)
     except SceneNotFoundError as e:
@@ -122,7 +121,7 @@ def cmd_tune(args: argparse.Namespace) -> int:
         seed=args.seed,
         plot=Path(args.plot) if args.plot else None,
         json=args.json,
-        disturb=tuple(args.disturb),
+        disturb=disturb,
         dataset=dataset,
         request=request,
     )

@@ -12,7 +12,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, TextIO
 
-from dial.disturb import parse_disturbance
+from dial.disturb import Disturbance
 from dial.parser.check import load
 from dial.resources import resolve_script
 from dial.scene import load_scene_names
@@ -38,7 +38,7 @@ class TuneOptions:
     plot: Path | None = None
     json: bool = False
     scene: str | None = None  # dial run --scene: an absolute path or a bundled name
-    disturb: tuple[str, ...] = ()  # dial run --disturb SPECs, checked by tune()
+    disturb: tuple[Disturbance, ...] = ()  # dial run --disturb, parsed (each keeps its text)
     dataset: Path | None = None  # --dataset DIR: each trial an episode (docs/datasets.md)
     request: Request | None = None  # its --fps, --cameras, --successful-only
 
@@ -105,7 +105,7 @@ def tune(
             "seed": options.seed,
         }
         if options.disturb:  # absent otherwise: a sweep without faults prints what it did
-            meta["disturb"] = list(options.disturb)
+            meta["disturb"] = [d.text for d in options.disturb]
         print(json.dumps(to_json(rows, **meta)), file=out)
     return status
 
@@ -115,7 +115,7 @@ def _plan(path: Path, options: TuneOptions) -> tuple[Script, list[Trial]]:
     error never starts a sweep."""
     script = load(path, loader=load_scene_names, scene=options.scene)
     if options.disturb:
-        check_pushes([parse_disturbance(d) for d in options.disturb], script_world(script))
+        check_pushes(options.disturb, script_world(script))
     return script, plan(
         str(path.resolve()),
         str(path),
@@ -124,7 +124,7 @@ def _plan(path: Path, options: TuneOptions) -> tuple[Script, list[Trial]]:
         options.seed,
         options.perturb_mm,
         options.scene,
-        options.disturb,
+        tuple(d.text for d in options.disturb),  # workers parse their texts
         options.request if options.dataset is not None else None,
     )
 
