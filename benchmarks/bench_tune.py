@@ -32,9 +32,9 @@ from dial.resources import resolve_script
 from dial.tune import (
     ProcessExecutor,
     RayExecutor,
-    RunReport,
     Trial,
     TrialResult,
+    TrialRun,
     engine_backend,
     models,
     parse_ticks,
@@ -45,7 +45,7 @@ from dial.tune import (
 WAITS = "DIAL_BENCH_WAITS"  # the folder where each worker notes its clock and CPU wait
 
 
-def _engine_noting_waits(trial: Trial) -> RunReport:
+def _engine_noting_waits(trial: Trial) -> TrialRun:
     """engine_backend, then note when it ended and how long this worker has waited for CPU."""
     report = engine_backend(trial)
     waited_ns = int(Path("/proc/self/schedstat").read_text().split()[1])

@@ -26,7 +26,7 @@ from dial.scheduler.log import EventLog
 from dial.scheduler.runner import Runner, Tally
 from dial.testing.fake import FakeFactory, FakeRobot
 from dial.tune.grid import Trial
-from dial.tune.trial import RunReport
+from dial.tune.trial import TrialRun
 
 
 class LimitedRobot(FakeRobot):
@@ -81,7 +81,7 @@ def limited_backend(
     max_speed: float = 1.0,
     tolerance: float = 0.02,
     fault_at: Mapping[int, str] | None = None,
-) -> RunReport:
+) -> TrialRun:
     """A ``dial.tune`` backend on the limited fake robot (``--perturb`` has no effect here).
 
     Bind the keywords with :func:`functools.partial` to keep it picklable.
@@ -90,6 +90,6 @@ def limited_backend(
     result = run_limited(script, trial.tick, max_speed, tolerance, fault_at)
     summary = result.summary
     error = str(summary.error) if summary.error is not None else None
-    return RunReport(
+    return TrialRun(
         {"reached_goal": result.reached_goal}, summary.sim_time, summary.tick_length, error
     )

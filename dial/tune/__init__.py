@@ -15,8 +15,8 @@ from dial.tune.ray_executor import RayExecutor
 from dial.tune.report import TickRow, fastest_reliable, render_table, summarise, to_json, verdict
 from dial.tune.trial import (
     Backend,
-    RunReport,
     TrialResult,
+    TrialRun,
     engine_backend,
     failed_trial,
     run_trial,
@@ -30,11 +30,11 @@ __all__ = [
     "ItemsDone",
     "ProcessExecutor",
     "RayExecutor",
-    "RunReport",
     "SerialExecutor",
     "TickRow",
     "Trial",
     "TrialResult",
+    "TrialRun",
     "TuneOptions",
     "engine_backend",
     "failed_trial",

@@ -1,6 +1,6 @@
 """Running one trial, on any backend, and the sweep over all of them.
 
-A backend turns a :class:`Trial` into a :class:`RunReport`. The real one runs
+A backend turns a :class:`Trial` into a :class:`TrialRun`. The real one runs
 the MuJoCo engine; tests pass a fake robot with a physical limit
 (:mod:`dial.testing.limited`). Whatever the backend does, :func:`run_trial`
 turns it into a :class:`TrialResult`: an exception is a failed trial with its
@@ -24,7 +24,7 @@ if TYPE_CHECKING:
 
 
 @dataclass(frozen=True)
-class RunReport:
+class TrialRun:
     """What a backend reports of one run."""
 
     success: Mapping[str, bool]  # criterion name -> held
@@ -49,10 +49,10 @@ class TrialResult:
     episode: Episode | None = None  # until the parent has written it (dial.tune.episodes)
 
 
-Backend = Callable[[Trial], RunReport]
+Backend = Callable[[Trial], TrialRun]
 
 
-def engine_backend(trial: Trial) -> RunReport:
+def engine_backend(trial: Trial) -> TrialRun:
     """Run the trial on the MuJoCo engine, as ``dial run --tick --seed --perturb --scene
     --disturb`` would."""
     from dial.disturb import parse_disturbance
@@ -77,7 +77,7 @@ def engine_backend(trial: Trial) -> RunReport:
     episode = None if recorder is None else recorder.episode
     if episode is not None and trial.dataset is not None and trial.dataset.successful_only:
         episode = episode if result.ok else None  # nothing to send back
-    return RunReport(result.success, summary.sim_time, summary.tick_length, error, episode)
+    return TrialRun(result.success, summary.sim_time, summary.tick_length, error, episode)
 
 
 def run_trial(backend: Backend, trial: Trial) -> TrialResult:

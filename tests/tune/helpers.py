@@ -10,7 +10,7 @@ import time
 from pathlib import Path
 
 from dial.testing.limited import limited_backend
-from dial.tune import RunReport, Trial
+from dial.tune import Trial, TrialRun
 
 # One trajectory move over four ticks of the index finger. On the limited fake robot
 # (1 unit/s, tolerance 0.02) it reaches min(1, 4 T): the shortest tick that gets within
@@ -25,26 +25,26 @@ def write_go(directory: Path) -> Path:
     return path
 
 
-def raising(trial: Trial) -> RunReport:
+def raising(trial: Trial) -> TrialRun:
     if trial.tick == BAD_TICK:
         raise RuntimeError(f"boom at {trial.tick:g} s")
     return limited_backend(trial)
 
 
-def diverging(trial: Trial) -> RunReport:
+def diverging(trial: Trial) -> TrialRun:
     """The robot's safety monitor trips at the 5th control period, as on a diverged state."""
     fault = {5: "non-finite physics state"} if trial.tick == BAD_TICK else None
     return limited_backend(trial, fault_at=fault)
 
 
-def dying(trial: Trial) -> RunReport:
+def dying(trial: Trial) -> TrialRun:
     """The worker process dies without a word, as on a crash in native code."""
     if trial.tick == BAD_TICK:
         os._exit(3)
     return limited_backend(trial)
 
 
-def dies_once(trial: Trial) -> RunReport:
+def dies_once(trial: Trial) -> TrialRun:
     """The worker dies the first time it runs the trial at BAD_TICK, and only then.
 
     A marker file beside the script remembers the death across worker processes.
@@ -56,7 +56,7 @@ def dies_once(trial: Trial) -> RunReport:
     return limited_backend(trial)
 
 
-def slow(trial: Trial) -> RunReport:
+def slow(trial: Trial) -> TrialRun:
     """Marks its start beside the script, then takes a second: for interrupting a sweep."""
     Path(trial.script).with_suffix(f".started-{trial.tick:g}").touch()
     time.sleep(1.0)
