@@ -93,6 +93,43 @@ def test_lightbulb_on_allegro_panda_when_10mm_off() -> None:
     assert not result.log.of("monitor")
 
 
+class CollarTouches:
+    """The simulated times (s) at which the bulb touches its socket, tested every control period."""
+
+    def __init__(self) -> None:
+        self.times: list[float] = []
+
+    def begin(self, run: dial.Watched) -> None:
+        self.robot = run.robot
+        model = self.robot.model
+        self.pair = {model.body("lightbulb_bulb").id, model.body("lightbulb_socket").id}
+
+    def period(self, periods: int, tick: int) -> None:
+        data, model = self.robot.data, self.robot.model
+        for c in data.contact[: data.ncon]:
+            if {model.geom_bodyid[c.geom1], model.geom_bodyid[c.geom2]} == self.pair:
+                self.times.append(float(data.time) - 0.5)  # from the first tick
+                return
+
+    def end(self, result: dial.RunResult | None) -> None:
+        pass
+
+
+def test_a_freed_bulb_comes_up_clear_of_the_collar_on_allegro_panda() -> None:
+    # Trial 2 of `dial tune ... --perturb 10 --seed 8314` (issue 24). With the pinch 10 mm below
+    # the glass centre, the freed bulb's base hung 2.5 mm off the socket's axis, caught the collar
+    # as the tug lifted it, the tug read 1.57 N (over its 1.5 N) and the loop went on: the bulb
+    # fell back into the socket. At 8 mm (worlds/lightbulb.toml) it comes up clear.
+    touches = CollarTouches()
+    script = dial.load(ROOT / "scripts" / "lightbulb.dial", scene="allegro_panda/lightbulb")
+    result = dial.run(script, perturb=10, seed=882851186, observers=[touches])
+    assert result.ok and result.success == {"bulb_out": True, "bulb_held": True}, result.details
+    tugs = ended(result, "tug")
+    assert [r["outcome"] for r in tugs] == ["done"] * 4 + ["missed"]
+    # The bulb never touches the socket (at 10 mm it did from 37.71 s, in the first free tug).
+    assert not touches.times
+
+
 def test_pour_on_allegro_panda_when_10mm_off() -> None:
     # Seed 3: the objects 10 mm off, away from the base and towards the cup (31 deg).
     script = dial.load(ROOT / "scripts" / "pour.dial", scene="allegro_panda/pour")
