@@ -93,22 +93,32 @@ def test_lightbulb_on_allegro_panda_when_10mm_off() -> None:
     assert not result.log.of("monitor")
 
 
-class CollarTouches:
-    """The simulated times (s) at which the bulb touches its socket, tested every control period."""
+class Touches:
+    """The simulated times (s from the first tick) at which two bodies touch, tested every
+    control period (:meth:`value`: what is recorded, :meth:`watching`: from when)."""
 
-    def __init__(self) -> None:
-        self.times: list[float] = []
+    def __init__(self, body: str, other: str) -> None:
+        self.bodies = (body, other)
+        self.values: list[float] = []
 
     def begin(self, run: dial.Watched) -> None:
         self.robot = run.robot
-        model = self.robot.model
-        self.pair = {model.body("lightbulb_bulb").id, model.body("lightbulb_socket").id}
+        self.body, other = (self.robot.model.body(name).id for name in self.bodies)
+        self.pair = {self.body, other}
+
+    def watching(self) -> bool:
+        return True
+
+    def value(self) -> float:
+        return float(self.robot.data.time) - 0.5
 
     def period(self, periods: int, tick: int) -> None:
         data, model = self.robot.data, self.robot.model
+        if not self.watching():
+            return
         for c in data.contact[: data.ncon]:
             if {model.geom_bodyid[c.geom1], model.geom_bodyid[c.geom2]} == self.pair:
-                self.times.append(float(data.time) - 0.5)  # from the first tick
+                self.values.append(self.value())
                 return
 
     def end(self, result: dial.RunResult | None) -> None:
@@ -120,14 +130,14 @@ def test_a_freed_bulb_comes_up_clear_of_the_collar_on_allegro_panda() -> None:
     # the glass centre, the freed bulb's base hung 2.5 mm off the socket's axis, caught the collar
     # as the tug lifted it, the tug read 1.57 N (over its 1.5 N) and the loop went on: the bulb
     # fell back into the socket. At 8 mm (worlds/lightbulb.toml) it comes up clear.
-    touches = CollarTouches()
+    touches = Touches("lightbulb_bulb", "lightbulb_socket")
     script = dial.load(ROOT / "scripts" / "lightbulb.dial", scene="allegro_panda/lightbulb")
     result = dial.run(script, perturb=10, seed=882851186, observers=[touches])
     assert result.ok and result.success == {"bulb_out": True, "bulb_held": True}, result.details
     tugs = ended(result, "tug")
     assert [r["outcome"] for r in tugs] == ["done"] * 4 + ["missed"]
     # The bulb never touches the socket (at 10 mm it did from 37.71 s, in the first free tug).
-    assert not touches.times
+    assert not touches.values
 
 
 def test_pour_on_allegro_panda_when_10mm_off() -> None:
@@ -148,3 +158,38 @@ def test_pour_on_allegro_panda_when_10mm_off() -> None:
     assert np.linalg.norm(shift) < 0.0035
     grasp = ended(result, "grabpit")[0]["data"]["forces"]
     assert min(grasp.values()) >= 40.0  # middle and thumb both reached the grasp's force
+
+
+class TableTilts(Touches):
+    """The pitcher's tilt (deg) in every control period in which it touches the table, once it
+    has been lifted 50 mm (the lift tips it on its edge before it is off)."""
+
+    def __init__(self) -> None:
+        super().__init__("pour_pitcher", "pour_table")
+        self.lifted = False
+
+    def watching(self) -> bool:
+        z = self.robot.data.xpos[self.body][2]
+        self.lifted = self.lifted or z > 0.40  # the table top: z 0.35
+        return self.lifted
+
+    def value(self) -> float:
+        up = min(1.0, float(self.robot.data.xmat[self.body][8]))
+        return float(np.degrees(np.arccos(up)))
+
+
+def test_the_poured_pitcher_meets_the_table_upright_on_allegro_panda() -> None:
+    # Trial 17 of `dial tune ... --perturb 10 --seed 8331` (issue 24). The pitcher hangs about
+    # 20 mm lower in the pinch after the pour than where it was taken; set 1 mm above the grasp,
+    # the straight return put its edge on the table 30 deg from upright, the hand turned it in
+    # the pinch about that edge, and a ball that had missed the cup (it landed on the curled
+    # ring finger and rode back) lay under it: released, it rested 10.2 deg tipped. With the
+    # set-down 20 mm higher and the ring half bent (worlds/pour.toml) the pitcher only ever
+    # touches the table upright, and every ball is in the cup.
+    tilts = TableTilts()
+    script = dial.load(ROOT / "scripts" / "pour.dial", scene="allegro_panda/pour")
+    result = dial.run(script, perturb=10, seed=3925225753, observers=[tilts])
+    poured = {"contents_in_cup": True, "pitcher_upright": True}
+    assert result.ok and result.success == poured, result.details
+    assert str(result.details["contents_in_cup"]).startswith("20/20")
+    assert tilts.values and max(tilts.values) < 3.0  # 1.9 deg here; 34.9 deg before
