@@ -139,6 +139,10 @@ class ScriptError(DialError):
         self.cutoffs = {d.path: d for d in found if isinstance(d, Cutoff)}
         super().__init__(self.render())
 
+    def __reduce__(self) -> tuple[type[ScriptError], tuple[tuple[Diagnostic, ...]]]:
+        # Pickled (a worker process's error) as what it was made from, not its message.
+        return type(self), ((*self.diagnostics, *self.cutoffs.values()),)
+
     def render(self) -> str:
         """Every diagnostic, at most :data:`MAX_SHOWN` per file, then how many more, and
         where the check of the file stopped if it did."""

@@ -155,6 +155,10 @@ class RobotFileError(DialError):
         self.diagnostics = diagnostics
         super().__init__("\n".join(d.header for d in diagnostics))
 
+    def __reduce__(self) -> tuple[type[RobotFileError], tuple[list[Diagnostic]]]:
+        # Pickled (a worker process's error) as what it was made from, not its message.
+        return type(self), (self.diagnostics,)
+
     def render(self) -> str:
         return "\n".join(d.render() for d in self.diagnostics)
 

@@ -20,8 +20,13 @@ class WorldFileError(DialError, ValueError):
     def __init__(self, path: Path | str, key: str, message: str) -> None:
         self.path = str(path)
         self.key = key
+        self.problem = message
         where = f"{self.path}: {key}: " if key else f"{self.path}: "
         super().__init__(where + message)
+
+    def __reduce__(self) -> tuple[type[WorldFileError], tuple[str, str, str]]:
+        # Pickled (a worker process's error) as what it was made from, not its message.
+        return type(self), (self.path, self.key, self.problem)
 
 
 class Reader:
