@@ -16,6 +16,7 @@ import pytest
 from numpy.typing import NDArray
 
 import dial
+from dial.engine.setup import SETTLE_S
 
 from ..conftest import ROOT
 from ..engine.recovery import ended
@@ -110,7 +111,7 @@ class Touches:
         return True
 
     def value(self) -> float:
-        return float(self.robot.data.time) - 0.5
+        return float(self.robot.data.time) - SETTLE_S  # the scene settles before the first tick
 
     def period(self, periods: int, tick: int) -> None:
         data, model = self.robot.data, self.robot.model
